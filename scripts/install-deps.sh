@@ -1,0 +1,19 @@
+#!/usr/bin/env bash
+# Installs immerse's build and run dependencies from Debian 12 packages (idempotent).
+set -euo pipefail
+pkgs=(cmake g++ make pkg-config
+      libfftw3-dev libhdf5-dev libtomlplusplus-dev libcli11-dev
+      petsc-dev
+      libgtest-dev libgmock-dev libbenchmark-dev
+      python3 python3-matplotlib python3-numpy python3-h5py)
+missing=()
+for p in "${pkgs[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+if [ ${#missing[@]} -gt 0 ]; then
+  echo "install-deps: installing ${missing[*]}"
+  SUDO=""; [ "$(id -u)" -ne 0 ] && SUDO="sudo"
+  export DEBIAN_FRONTEND=noninteractive
+  $SUDO apt-get update -qq
+  $SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
+fi

@@ -1,0 +1,19 @@
+#include "immerse/core/Error.hpp"
+
+#include <sstream>
+
+namespace immerse {
+
+void require(bool ok, const std::string& name, double value, const std::string& allowed) {
+  if (ok) return;
+  std::ostringstream s;
+  s.precision(17);
+  s << name << " = " << value << ": must be " << allowed;
+  throw InputError(s.str());
+}
+
+void require(bool ok, const std::string& name, const std::string& allowed) {
+  if (!ok) throw InputError(name + ": must be " + allowed);
+}
+
+}  // namespace immerse
