@@ -1,0 +1,38 @@
+#include "immerse/timestep/MembraneIntegrator.hpp"
+
+#include <cmath>
+
+#include "immerse/core/Error.hpp"
+#include "immerse/timestep/DenseBfgs.hpp"
+#include "immerse/timestep/ForwardEuler.hpp"
+#include "immerse/timestep/MidpointRK2.hpp"
+#include "immerse/timestep/SnesIntegrator.hpp"
+
+namespace immerse {
+
+void SolverSettings::validate() const {
+  require(theta >= 0.5 && theta <= 1.0, "time.theta", theta, "in [0.5, 1] (0.5 trapezoidal, 1 backward Euler)");
+  require(std::isfinite(newton_rtol) && newton_rtol > 0 && newton_rtol < 1, "solver.newton_rtol", newton_rtol,
+          "in (0, 1)");
+  require(std::isfinite(gmres_rtol) && gmres_rtol > 0 && gmres_rtol < 1, "solver.gmres_rtol", gmres_rtol,
+          "in (0, 1)");
+  require(max_newton_its >= 1, "solver.max_newton_its", max_newton_its, "an integer >= 1");
+  require(bfgs_memory >= 1, "solver.bfgs_memory", bfgs_memory, "an integer >= 1");
+}
+
+const std::vector<std::string>& integrator_names() {
+  static const std::vector<std::string> names{"euler", "rk2", "jfnk", "bfgs", "lbfgs"};
+  return names;
+}
+
+std::unique_ptr<MembraneIntegrator> make_integrator(const std::string& name, const SolverSettings& settings) {
+  settings.validate();
+  if (name == "euler") return std::make_unique<ForwardEuler>();
+  if (name == "rk2") return std::make_unique<MidpointRK2>();
+  if (name == "jfnk") return std::make_unique<SnesIntegrator>(SnesIntegrator::Method::NewtonKrylov, settings);
+  if (name == "lbfgs") return std::make_unique<SnesIntegrator>(SnesIntegrator::Method::LimitedMemoryBFGS, settings);
+  if (name == "bfgs") return std::make_unique<DenseBfgs>(settings);
+  throw InputError("time.scheme = '" + name + "': must be one of euler, rk2, jfnk, bfgs, lbfgs");
+}
+
+}  // namespace immerse

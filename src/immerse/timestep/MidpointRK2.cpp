@@ -1,0 +1,24 @@
+#include "immerse/timestep/MidpointRK2.hpp"
+
+namespace immerse {
+
+StepStats MidpointRK2::step(CoupledOperator& op, double dt) {
+  const std::size_t n = op.size(), solves0 = op.fluid_solves();
+  const auto Xn = op.positions();
+  const auto Un = op.node_velocity();
+  Xm_.resize(n);
+  U0_.resize(n);
+  U1_.resize(n);
+  X_.resize(n);
+  for (std::size_t i = 0; i < n; ++i) Xm_[i] = Xn[i] + 0.5 * dt * Un[i];
+  op.trial_velocity(Xm_, 1.0, Xm_, dt, U1_);
+  op.committed_velocity(Xm_, U0_);
+  for (std::size_t i = 0; i < n; ++i) X_[i] = Xn[i] + 0.5 * dt * (U0_[i] + U1_[i]);
+  remember(op, dt);
+  op.commit(X_, dt);
+  StepStats s;
+  s.fluid_solves = op.fluid_solves() - solves0;
+  return s;
+}
+
+}  // namespace immerse

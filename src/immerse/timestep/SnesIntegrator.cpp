@@ -1,0 +1,172 @@
+#include "immerse/timestep/SnesIntegrator.hpp"
+
+#include <cmath>
+#include <sstream>
+
+#include "immerse/core/Error.hpp"
+#include "immerse/timestep/PetscSession.hpp"
+
+namespace immerse {
+
+SnesIntegrator::SnesIntegrator(Method method, const SolverSettings& settings) : method_(method), settings_(settings) {
+  settings_.validate();
+  IMMERSE_PETSC(PetscOptionsCreate(&options_));
+  if (!settings_.petsc_options.empty() && PetscOptionsInsertString(options_, settings_.petsc_options.c_str()) != 0)
+    throw InputError("solver.petsc_options = '" + settings_.petsc_options + "': PETSc cannot parse it");
+}
+
+SnesIntegrator::~SnesIntegrator() {
+  if (snes_) SNESDestroy(&snes_);
+  if (J_) MatDestroy(&J_);
+  if (x_) VecDestroy(&x_);
+  if (r_) VecDestroy(&r_);
+  if (options_) PetscOptionsDestroy(&options_);
+}
+
+void SnesIntegrator::setup(std::size_t n) {
+  n_ = n;
+  const auto N = static_cast<PetscInt>(n);
+  IMMERSE_PETSC(VecCreateSeq(PETSC_COMM_SELF, N, &x_));
+  IMMERSE_PETSC(VecDuplicate(x_, &r_));
+  IMMERSE_PETSC(SNESCreate(PETSC_COMM_SELF, &snes_));
+  IMMERSE_PETSC(PetscObjectSetOptions(reinterpret_cast<PetscObject>(snes_), options_));
+  IMMERSE_PETSC(SNESSetFunction(snes_, r_, &SnesIntegrator::form_function, this));
+  IMMERSE_PETSC(SNESSetConvergenceTest(snes_, &SnesIntegrator::converged, this, nullptr));
+  IMMERSE_PETSC(SNESSetTolerances(snes_, 0.0, 0.0, 0.0, settings_.max_newton_its, 1000000));
+  SNESLineSearch ls;
+  if (method_ == Method::NewtonKrylov) {
+    IMMERSE_PETSC(SNESSetType(snes_, SNESNEWTONLS));
+    IMMERSE_PETSC(MatCreateSNESMF(snes_, &J_));
+    IMMERSE_PETSC(PetscObjectSetOptions(reinterpret_cast<PetscObject>(J_), options_));
+    IMMERSE_PETSC(MatMFFDSetType(J_, MATMFFD_WP));  // eq. (37)
+    IMMERSE_PETSC(SNESSetJacobian(snes_, J_, J_, MatMFFDComputeJacobian, nullptr));
+    KSP ksp;
+    PC pc;
+    IMMERSE_PETSC(SNESGetKSP(snes_, &ksp));
+    IMMERSE_PETSC(KSPSetType(ksp, KSPGMRES));
+    IMMERSE_PETSC(KSPSetTolerances(ksp, settings_.gmres_rtol, PETSC_DEFAULT, PETSC_DEFAULT, 200));
+    IMMERSE_PETSC(KSPGetPC(ksp, &pc));
+    IMMERSE_PETSC(PCSetType(pc, PCNONE));  // the paper's GMRES is unpreconditioned
+  } else {
+    IMMERSE_PETSC(SNESSetType(snes_, SNESQN));
+    IMMERSE_PETSC(SNESQNSetType(snes_, SNES_QN_LBFGS));
+    IMMERSE_PETSC(SNESQNSetScaleType(snes_, SNES_QN_SCALE_NONE));  // H_0 = I: J = I - (dt/2) u' (32)
+    IMMERSE_PETSC(SNESQNSetRestartType(snes_, SNES_QN_RESTART_NONE));
+    std::ostringstream m;
+    m << settings_.bfgs_memory;
+    IMMERSE_PETSC(PetscOptionsSetValue(options_, "-snes_qn_m", m.str().c_str()));
+  }
+  IMMERSE_PETSC(SNESGetLineSearch(snes_, &ls));
+  IMMERSE_PETSC(SNESLineSearchSetType(ls, SNESLINESEARCHBASIC));  // full steps, eq. (34)
+  IMMERSE_PETSC(SNESSetSolution(snes_, x_));
+  IMMERSE_PETSC(SNESSetFromOptions(snes_));
+  IMMERSE_PETSC(SNESSetUp(snes_));
+  PetscInt left = 0;
+  char **names = nullptr, **values = nullptr;
+  IMMERSE_PETSC(PetscOptionsLeftGet(options_, &left, &names, &values));
+  std::string unused;
+  for (PetscInt i = 0; i < left; ++i) unused += (unused.empty() ? "-" : ", -") + std::string(names[i]);
+  IMMERSE_PETSC(PetscOptionsLeftRestore(options_, &left, &names, &values));
+  if (!unused.empty())
+    throw InputError("solver.petsc_options: PETSc does not know option " + unused + " for the '" + name() +
+                     "' solver (see -help of PETSc's SNES, KSP and MatMFFD)");
+}
+
+PetscErrorCode SnesIntegrator::form_function(SNES, Vec x, Vec f, void* ctx) {
+  auto* self = static_cast<SnesIntegrator*>(ctx);
+  const PetscScalar* xs;
+  PetscScalar* fs;
+  PetscCall(VecGetArrayRead(x, &xs));
+  for (std::size_t i = 0; i < self->n_; ++i) self->X_[i] = self->scale_ * xs[i];
+  PetscCall(VecRestoreArrayRead(x, &xs));
+  try {
+    (*self->residual_)(self->X_, self->g_);
+  } catch (...) {
+    self->callback_error_ = std::current_exception();
+    return PETSC_ERR_USER;
+  }
+  PetscCall(VecGetArray(f, &fs));
+  for (std::size_t i = 0; i < self->n_; ++i) fs[i] = self->g_[i] / self->scale_;
+  PetscCall(VecRestoreArray(f, &fs));
+  return 0;
+}
+
+PetscErrorCode SnesIntegrator::converged(SNES snes, PetscInt it, PetscReal, PetscReal, PetscReal fnorm,
+                                         SNESConvergedReason* reason, void* ctx) {
+  auto* self = static_cast<SnesIntegrator*>(ctx);
+  Vec x;
+  PetscReal xnorm;
+  PetscCall(SNESGetSolution(snes, &x));
+  PetscCall(VecNorm(x, NORM_2, &xnorm));
+  self->last_ratio_ = fnorm / xnorm;  // ||g|| / ||X||, independent of the scaling
+  *reason = SNES_CONVERGED_ITERATING;
+  if (!std::isfinite(fnorm))
+    *reason = SNES_DIVERGED_FNORM_NAN;
+  else if (fnorm <= self->settings_.newton_rtol * xnorm)
+    *reason = SNES_CONVERGED_FNORM_RELATIVE;
+  else if (it >= self->settings_.max_newton_its)
+    *reason = SNES_DIVERGED_MAX_IT;
+  return 0;
+}
+
+StepStats SnesIntegrator::step(CoupledOperator& op, double dt) {
+  if (!snes_) setup(op.size());
+  if (op.size() != n_) throw std::logic_error("SnesIntegrator: the number of unknowns changed");
+  StepStats stats;
+  const std::size_t solves0 = op.fluid_solves();
+  ThetaResidual residual(op, dt, settings_.theta);
+  residual_ = &residual;
+  scale_ = op.length_scale();
+  X_.resize(n_);
+  g_.resize(n_);
+  callback_error_ = nullptr;
+
+  PetscScalar* xs;
+  IMMERSE_PETSC(VecGetArray(x_, &xs));
+  {
+    std::vector<double> X0(n_);
+    residual.initial_guess(previous_positions(), previous_dt(), X0);
+    for (std::size_t i = 0; i < n_; ++i) xs[i] = X0[i] / scale_;
+  }
+  IMMERSE_PETSC(VecRestoreArray(x_, &xs));
+
+  const PetscErrorCode ierr = SNESSolve(snes_, nullptr, x_);
+  residual_ = nullptr;
+  PetscInt its = 0, lits = 0;
+  SNESGetIterationNumber(snes_, &its);
+  SNESGetLinearSolveIterations(snes_, &lits);
+  stats.newton_its = static_cast<int>(its);
+  stats.gmres_its = static_cast<int>(lits);
+  stats.residual = last_ratio_;
+  SNESConvergedReason reason = SNES_CONVERGED_ITERATING;
+  if (ierr == 0) SNESGetConvergedReason(snes_, &reason);
+  if (ierr != 0 || reason <= 0) {
+    stats.converged = false;
+    if (callback_error_) {
+      try {
+        std::rethrow_exception(callback_error_);
+      } catch (const SimulationError& e) {
+        stats.failure = e.what();
+      }
+    } else if (ierr != 0) {
+      check_petsc(ierr, "SNESSolve");
+    } else {
+      stats.failure = std::string("nonlinear solve did not converge (") + SNESConvergedReasons[reason] + ") after " +
+                      std::to_string(its) + " iterations, ||g||/||X|| = " + std::to_string(last_ratio_);
+    }
+    stats.fluid_solves = op.fluid_solves() - solves0;
+    return stats;
+  }
+  const PetscScalar* xr;
+  IMMERSE_PETSC(VecGetArrayRead(x_, &xr));
+  for (std::size_t i = 0; i < n_; ++i) X_[i] = scale_ * xr[i];
+  IMMERSE_PETSC(VecRestoreArrayRead(x_, &xr));
+  // The trial fluid state must be the one driven by the accepted positions.
+  if (!residual.trial_matches(X_)) residual(X_, g_);
+  remember(op, dt);
+  op.commit(X_, dt);
+  stats.fluid_solves = op.fluid_solves() - solves0;
+  return stats;
+}
+
+}  // namespace immerse

@@ -1,0 +1,163 @@
+// The membrane integrators of §2.4 on a coupled problem with an exact solution (ToyOperator.hpp).
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "PetscEnvironment.hpp"
+#include "ToyOperator.hpp"
+#include "immerse/core/Error.hpp"
+#include "immerse/timestep/MembraneIntegrator.hpp"
+#include "immerse/verify/Convergence.hpp"
+
+using namespace immerse;
+using immerse::testing::ToyOperator;
+
+namespace {
+
+constexpr double K = 40.0, A = 0.5, RHO = 1.0, X0 = 0.1, T = 1.0;
+
+ToyOperator make_toy(double k = K) { return ToyOperator({1.0 + X0, 2.0, 3.0}, {1.0, 2.0, 3.0}, k, A, RHO); }
+
+// Errors of x and v against the exact damped oscillator, in the max norm over the trajectory on [0, T]
+// (an error at one instant can pass through zero and fake a convergence order).
+std::pair<double, double> run(const std::string& scheme, int steps, SolverSettings s = {}) {
+  auto op = make_toy();
+  auto integ = make_integrator(scheme, s);
+  const double dt = T / steps;
+  double ex = 0, ev = 0;
+  for (int i = 0; i < steps; ++i) {
+    const auto st = integ->step(op, dt);
+    EXPECT_TRUE(st.converged) << st.failure;
+    const auto [x, v] = op.exact(X0, op.time());
+    ex = std::max(ex, std::abs(op.positions()[0] - 1.0 - x));
+    ev = std::max(ev, std::abs(op.velocity()[0] - v));
+  }
+  return {ex, ev};
+}
+
+double order(const std::string& scheme, bool of_velocity, SolverSettings s = {}, int coarsest = 40) {
+  std::vector<double> e;
+  for (int steps : {coarsest, 2 * coarsest, 4 * coarsest}) {
+    const auto [ex, ev] = run(scheme, steps, s);
+    e.push_back(of_velocity ? ev : ex);
+  }
+  return verify::min_observed_order(e);
+}
+
+}  // namespace
+
+TEST(Integrators, TrapezoidalJfnkIsSecondOrderForPositionAndVelocity) {
+  const double px = order("jfnk", false), pv = order("jfnk", true);
+  std::cout << "jfnk observed orders: X " << px << ", u " << pv << "\n";
+  EXPECT_GE(px, 1.9);
+  EXPECT_GE(pv, 1.9);
+}
+
+TEST(Integrators, QuasiNewtonVariantsAreSecondOrder) {
+  for (const char* scheme : {"bfgs", "lbfgs"}) {
+    const double px = order(scheme, false), pv = order(scheme, true);
+    std::cout << scheme << " observed orders: X " << px << ", u " << pv << "\n";
+    EXPECT_GE(px, 1.9) << scheme;
+    EXPECT_GE(pv, 1.9) << scheme;
+  }
+}
+
+TEST(Integrators, MidpointRK2IsSecondOrderAndEulerFirst) {
+  const double p2 = order("rk2", false), p1 = order("euler", false);
+  std::cout << "rk2 order " << p2 << ", euler order " << p1 << "\n";
+  EXPECT_GE(p2, 1.9);
+  EXPECT_GE(p1, 0.9);
+  EXPECT_LE(p1, 1.2);
+}
+
+TEST(Integrators, BackwardEulerThetaIsFirstOrder) {
+  SolverSettings s;
+  s.theta = 1.0;
+  const double p = order("jfnk", false, s, 320);
+  std::cout << "theta = 1 order " << p << "\n";
+  EXPECT_GE(p, 0.9);
+  EXPECT_LE(p, 1.2);
+}
+
+TEST(Integrators, BackwardEulerRemovesTheRingingOfStiffModes) {
+  // K = 1e4, dt = 0.05: the stiff mode's trapezoidal amplification factor is close to -1 (it rings, barely damped),
+  // the L-stable theta = 1 damps it in a few steps.
+  SolverSettings trap, be;
+  be.theta = 1.0;
+  auto a = make_toy(1e4), b = make_toy(1e4);
+  auto ia = make_integrator("jfnk", trap), ib = make_integrator("jfnk", be);
+  int sign_changes = 0;
+  double prev = X0;
+  for (int i = 0; i < 20; ++i) {
+    ASSERT_TRUE(ia->step(a, 0.05).converged);
+    ASSERT_TRUE(ib->step(b, 0.05).converged);
+    const double x = a.positions()[0] - 1.0;
+    sign_changes += (x * prev < 0);
+    prev = x;
+  }
+  std::cout << "after 20 steps: trapezoidal |x| = " << std::abs(prev) << " (" << sign_changes
+            << " sign changes), backward Euler |x| = " << std::abs(b.positions()[0] - 1.0) << "\n";
+  EXPECT_GE(sign_changes, 15);
+  EXPECT_GT(std::abs(prev), 0.1 * X0);
+  EXPECT_LT(std::abs(b.positions()[0] - 1.0), 1e-3 * X0);
+}
+
+TEST(Integrators, QuasiNewtonAndJfnkReachTheSameStep) {
+  SolverSettings s;
+  s.newton_rtol = 1e-12;
+  auto a = make_toy(), b = make_toy(), c = make_toy();
+  auto jfnk = make_integrator("jfnk", s), bfgs = make_integrator("bfgs", s), lbfgs = make_integrator("lbfgs", s);
+  for (int i = 0; i < 3; ++i) {
+    EXPECT_TRUE(jfnk->step(a, 0.05).converged);
+    EXPECT_TRUE(bfgs->step(b, 0.05).converged);
+    EXPECT_TRUE(lbfgs->step(c, 0.05).converged);
+  }
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    EXPECT_NEAR(a.positions()[i], b.positions()[i], 1e-10);
+    EXPECT_NEAR(a.positions()[i], c.positions()[i], 1e-10);
+  }
+}
+
+TEST(Integrators, StiffSpringBreaksEulerButNotJfnk) {
+  // K = 1e4: Euler's stability limit is dt ~ 2 sqrt(rho/K)-ish; take dt = 0.05, far beyond.
+  auto e = make_toy(1e4), j = make_toy(1e4);
+  auto euler = make_integrator("euler", {}), jfnk = make_integrator("jfnk", {});
+  for (int i = 0; i < 40; ++i) {
+    euler->step(e, 0.05);
+    const auto st = jfnk->step(j, 0.05);
+    ASSERT_TRUE(st.converged) << st.failure;
+    EXPECT_LE(st.newton_its, 4);
+  }
+  EXPECT_GT(std::abs(e.positions()[0] - 1.0), 1e3);   // explicit: blown up
+  EXPECT_LT(std::abs(j.positions()[0] - 1.0), X0);     // implicit: bounded, decaying
+}
+
+TEST(Integrators, JfnkCountsIterationsAndFluidSolves) {
+  auto op = make_toy();
+  auto jfnk = make_integrator("jfnk", {});
+  jfnk->step(op, 0.05);
+  const auto st = jfnk->step(op, 0.05);
+  ASSERT_TRUE(st.converged);
+  EXPECT_GE(st.newton_its, 1);
+  EXPECT_GE(st.gmres_its, st.newton_its);
+  // One g(X) per Newton iterate plus one per GMRES product (eq. 36).
+  EXPECT_EQ(st.fluid_solves, static_cast<std::size_t>(1 + st.newton_its + st.gmres_its));
+  EXPECT_LT(st.residual, 1e-8);
+}
+
+TEST(Integrators, BadNamesAndSettingsAreRejected) {
+  EXPECT_THROW(make_integrator("leapfrog", {}), InputError);
+  SolverSettings s;
+  s.gmres_rtol = 0;
+  EXPECT_THROW(make_integrator("jfnk", s), InputError);
+  SolverSettings p;
+  p.petsc_options = "-snes_no_such_option 3";
+  auto op = make_toy();
+  auto jfnk = make_integrator("jfnk", p);
+  try {
+    jfnk->step(op, 0.05);
+    FAIL() << "unknown PETSc option accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("-snes_no_such_option"), std::string::npos) << e.what();
+  }
+}
