@@ -6,6 +6,7 @@
 #include "PetscEnvironment.hpp"
 #include "ToyOperator.hpp"
 #include "immerse/core/Error.hpp"
+#include "immerse/timestep/AdaptiveStepper.hpp"
 #include "immerse/timestep/MembraneIntegrator.hpp"
 #include "immerse/verify/Convergence.hpp"
 
@@ -160,4 +161,57 @@ TEST(Integrators, BadNamesAndSettingsAreRejected) {
   } catch (const InputError& e) {
     EXPECT_NE(std::string(e.what()).find("-snes_no_such_option"), std::string::npos) << e.what();
   }
+}
+
+namespace {
+// Fails every fluid step longer than a threshold, as a node leaving the domain would.
+class Fragile final : public CoupledOperator {
+ public:
+  explicit Fragile(ToyOperator& inner, double max_dt) : in_(inner), max_dt_(max_dt) {}
+  std::size_t size() const override { return in_.size(); }
+  std::span<const double> positions() const override { return in_.positions(); }
+  std::span<const double> node_velocity() const override { return in_.node_velocity(); }
+  double length_scale() const override { return 1.0; }
+  void trial_velocity(std::span<const double> Xf, double theta, std::span<const double> Xi, double dt,
+                      std::span<double> U) override {
+    if (dt > max_dt_) throw SimulationError("node 0 is outside the fluid domain");
+    in_.trial_velocity(Xf, theta, Xi, dt, U);
+  }
+  void committed_velocity(std::span<const double> Xi, std::span<double> U) override {
+    in_.committed_velocity(Xi, U);
+  }
+  void commit(std::span<const double> X, double dt) override { in_.commit(X, dt); }
+  std::size_t fluid_solves() const override { return in_.fluid_solves(); }
+
+ private:
+  ToyOperator& in_;
+  double max_dt_;
+};
+}  // namespace
+
+TEST(AdaptiveStepper, HalvesOnFailureAndGrowsBack) {
+  auto toy = make_toy();
+  Fragile op(toy, 0.03);
+  auto jfnk = make_integrator("jfnk", {});
+  AdaptiveStepper stepper(0.1, 1e-3, 2);
+  std::vector<std::string> logs;
+  auto log = [&](const std::string& s) { logs.push_back(s); };
+  const auto first = stepper.advance(*jfnk, op, 1.0, log);
+  EXPECT_DOUBLE_EQ(first.dt, 0.025);  // 0.1 -> 0.05 -> 0.025
+  EXPECT_EQ(first.rejected, 2);
+  ASSERT_EQ(logs.size(), 2u);
+  EXPECT_NE(logs[0].find("outside the fluid domain"), std::string::npos) << logs[0];
+  EXPECT_NE(logs[0].find("retrying with dt = 0.05"), std::string::npos) << logs[0];
+  EXPECT_NEAR(toy.time(), 0.025, 1e-15);  // only the accepted step was committed
+  stepper.advance(*jfnk, op, 1.0, log);   // second success: grows to 0.05
+  EXPECT_DOUBLE_EQ(stepper.dt(), 0.05);
+}
+
+TEST(AdaptiveStepper, StopsBelowTheFloor) {
+  auto toy = make_toy();
+  Fragile op(toy, 1e-6);
+  auto jfnk = make_integrator("jfnk", {});
+  AdaptiveStepper stepper(0.1, 1e-3);
+  EXPECT_THROW(stepper.advance(*jfnk, op, 1.0, [](const std::string&) {}), SimulationError);
+  EXPECT_EQ(toy.time(), 0.0);
 }
