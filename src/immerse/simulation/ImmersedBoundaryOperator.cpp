@@ -1,0 +1,93 @@
+#include "immerse/simulation/ImmersedBoundaryOperator.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <string>
+
+#include "immerse/core/Error.hpp"
+#include "immerse/coupling/NodeDiagnostics.hpp"
+
+namespace immerse {
+
+ImmersedBoundaryOperator::ImmersedBoundaryOperator(NavierStokesSolver& fluid, IBCoupler& coupler,
+                                                   std::vector<const ElasticMembrane*> membranes,
+                                                   std::vector<std::vector<Vec3>> X0, FluidState fluid_state)
+    : fluid_(fluid),
+      coupler_(coupler),
+      membranes_(std::move(membranes)),
+      committed_(std::move(fluid_state)),
+      force_start_(fluid.grid()),
+      force_(fluid.grid()),
+      scratch_(fluid.grid()) {
+  if (X0.size() != membranes_.size()) throw std::logic_error("ImmersedBoundaryOperator: one position array per membrane");
+  for (std::size_t m = 0; m < membranes_.size(); ++m) {
+    if (X0[m].size() != membranes_[m]->num_nodes())
+      throw InputError("membrane[" + std::to_string(m) + "]: " + std::to_string(X0[m].size()) +
+                       " initial positions for a mesh of " + std::to_string(membranes_[m]->num_nodes()) + " nodes");
+    offset_.push_back(X_.size());
+    X_.insert(X_.end(), X0[m].begin(), X0[m].end());
+    Xm_.emplace_back(X0[m].size());
+    Fm_.emplace_back(X0[m].size());
+  }
+  offset_.push_back(X_.size());
+  F_.resize(X_.size());
+  U_.resize(X_.size());
+  membrane_force_density(X_, force_start_);
+  coupler_.interpolate_velocity(committed_.u, X_, U_);
+}
+
+void ImmersedBoundaryOperator::membrane_force_density(std::span<const Vec3> X, FaceField& f) {
+  for (std::size_t m = 0; m < membranes_.size(); ++m) {
+    std::copy(X.begin() + static_cast<std::ptrdiff_t>(offset_[m]), X.begin() + static_cast<std::ptrdiff_t>(offset_[m + 1]),
+              Xm_[m].begin());
+    try {
+      check_nodes_in_domain(fluid_.grid(), Xm_[m]);
+      membranes_[m]->compute_force(Xm_[m], Fm_[m]);
+    } catch (const SimulationError& e) {
+      throw SimulationError("membrane " + std::to_string(m) + ": " + e.what());
+    }
+    std::copy(Fm_[m].begin(), Fm_[m].end(), F_.begin() + static_cast<std::ptrdiff_t>(offset_[m]));
+  }
+  coupler_.spread_force(X, F_, f);
+}
+
+void ImmersedBoundaryOperator::trial_velocity(std::span<const double> Xf, double theta, std::span<const double> Xi,
+                                              double dt, std::span<double> U) {
+  membrane_force_density(nodes(Xf), force_);
+  if (theta < 1.0) {
+    for (int d = 0; d < 3; ++d) {
+      auto& a = force_[d];
+      const auto& b = force_start_[d];
+#pragma omp parallel for
+      for (std::size_t i = 0; i < a.size(); ++i) a[i] = theta * a[i] + (1.0 - theta) * b[i];
+    }
+  }
+  fluid_.step(committed_, force_, dt, trial_);
+  ++solves_;
+  coupler_.interpolate_velocity(trial_.u, nodes(Xi), {reinterpret_cast<Vec3*>(U.data()), U.size() / 3});
+}
+
+void ImmersedBoundaryOperator::committed_velocity(std::span<const double> Xi, std::span<double> U) {
+  coupler_.interpolate_velocity(committed_.u, nodes(Xi), {reinterpret_cast<Vec3*>(U.data()), U.size() / 3});
+}
+
+void ImmersedBoundaryOperator::commit(std::span<const double> X, double) {
+  std::swap(committed_, trial_);
+  const auto Xn = nodes(X);
+  std::copy(Xn.begin(), Xn.end(), X_.begin());
+  coupler_.interpolate_velocity(committed_.u, X_, U_);
+  membrane_force_density(X_, force_start_);
+}
+
+std::vector<Vec3> ImmersedBoundaryOperator::membrane_positions(std::size_t m) const {
+  return {X_.begin() + static_cast<std::ptrdiff_t>(offset_[m]), X_.begin() + static_cast<std::ptrdiff_t>(offset_[m + 1])};
+}
+
+std::vector<Vec3> ImmersedBoundaryOperator::membrane_velocities(std::size_t m) const {
+  return {U_.begin() + static_cast<std::ptrdiff_t>(offset_[m]), U_.begin() + static_cast<std::ptrdiff_t>(offset_[m + 1])};
+}
+
+double ImmersedBoundaryOperator::min_wall_distance() const { return immerse::min_wall_distance(fluid_.grid(), X_); }
+
+}  // namespace immerse

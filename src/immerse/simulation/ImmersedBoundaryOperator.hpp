@@ -1,0 +1,72 @@
+#pragma once
+// The coupled fluid-membrane step as the integrators see it (timestep/CoupledOperator.hpp): the algorithm of §3.
+//
+//   f(X)      membrane forces at the nodes           ElasticMembrane::compute_force  (§2.3, eq. 42 or -dE/dX)
+//   S(X) f    spread to the MAC faces                 IBCoupler::spread_force          (eq. 6)
+//   u^{n+1}   one projection step driven by F^{n+1/2}  NavierStokesSolver::step        (eqs. 9-13)
+//   J(X) u    interpolated back to the nodes          IBCoupler::interpolate_velocity  (eq. 14)
+//
+// with F^{n+1/2} = (1 - theta) S(X^n) f(X^n) + theta S(Xf) f(Xf); S(X^n) f(X^n) is computed once per step (at
+// commit). The committed fluid state is never modified by trial steps; commit() swaps the last trial in.
+// All membranes' nodes are concatenated in one array; errors name the membrane and its local node or element.
+#include <vector>
+
+#include "immerse/coupling/IBCoupler.hpp"
+#include "immerse/fluid/NavierStokesSolver.hpp"
+#include "immerse/membrane/ElasticMembrane.hpp"
+#include "immerse/timestep/CoupledOperator.hpp"
+
+namespace immerse {
+
+class ImmersedBoundaryOperator final : public CoupledOperator {
+ public:
+  /// `membranes` and their initial positions X0 (one array per membrane); the fluid starts from `fluid_state`.
+  ImmersedBoundaryOperator(NavierStokesSolver& fluid, IBCoupler& coupler,
+                           std::vector<const ElasticMembrane*> membranes, std::vector<std::vector<Vec3>> X0,
+                           FluidState fluid_state);
+
+  std::size_t size() const override { return 3 * X_.size(); }
+  std::span<const double> positions() const override { return flat(X_); }
+  std::span<const double> node_velocity() const override { return flat(U_); }
+  double length_scale() const override { return fluid_.grid().h(); }
+  void trial_velocity(std::span<const double> Xf, double theta, std::span<const double> Xi, double dt,
+                      std::span<double> U) override;
+  void committed_velocity(std::span<const double> Xi, std::span<double> U) override;
+  void commit(std::span<const double> X, double dt) override;
+  std::size_t fluid_solves() const override { return solves_; }
+
+  const FluidState& fluid_state() const { return committed_; }
+  std::size_t num_membranes() const { return membranes_.size(); }
+  /// Committed positions of membrane m.
+  std::vector<Vec3> membrane_positions(std::size_t m) const;
+  /// Committed node velocities of membrane m.
+  std::vector<Vec3> membrane_velocities(std::size_t m) const;
+  /// Smallest distance of any node to a wall (infinity without walls).
+  double min_wall_distance() const;
+
+ private:
+  static std::span<const double> flat(const std::vector<Vec3>& v) {
+    return {reinterpret_cast<const double*>(v.data()), 3 * v.size()};
+  }
+  static std::span<const Vec3> nodes(std::span<const double> x) {
+    return {reinterpret_cast<const Vec3*>(x.data()), x.size() / 3};
+  }
+  /// f = S(X) f(X) for all membranes.
+  void membrane_force_density(std::span<const Vec3> X, FaceField& f);
+
+  NavierStokesSolver& fluid_;
+  IBCoupler& coupler_;
+  std::vector<const ElasticMembrane*> membranes_;
+  std::vector<std::size_t> offset_;  ///< first node of membrane m in the concatenated arrays
+  std::vector<Vec3> X_, U_;          ///< committed positions and node velocities
+  FluidState committed_, trial_;
+  FaceField force_start_;  ///< S(X^n) f(X^n)
+  FaceField force_, scratch_;
+  std::vector<Vec3> F_;                                 ///< nodal forces, all membranes
+  std::vector<std::vector<Vec3>> Xm_, Fm_;              ///< per-membrane scratch for compute_force
+  std::size_t solves_ = 0;
+};
+
+static_assert(sizeof(Vec3) == 3 * sizeof(double), "positions are viewed as flat arrays of doubles");
+
+}  // namespace immerse
