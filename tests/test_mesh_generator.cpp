@@ -6,6 +6,7 @@
 
 #include "immerse/core/Error.hpp"
 #include "immerse/membrane/MeshGenerator.hpp"
+#include "immerse/membrane/MeshValidation.hpp"
 
 using namespace immerse;
 
@@ -70,5 +71,12 @@ TEST(MeshGenerator, RejectsLevelsOutOfRange) {
     FAIL();
   } catch (const InputError& e) {
     EXPECT_NE(std::string(e.what()).find("mesh.level = 8"), std::string::npos) << e.what();
+  }
+}
+
+TEST(MeshGenerator, GeneratedMeshesAreValidClosedMeshes) {
+  for (int level = 0; level <= 3; ++level) {
+    EXPECT_NO_THROW(validate_closed_mesh(icosahedral_sphere(level), "icosahedral"));
+    EXPECT_NO_THROW(validate_closed_mesh(octahedral_sphere(level), "octahedral"));
   }
 }

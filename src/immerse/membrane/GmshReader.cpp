@@ -105,6 +105,7 @@ class Parser {
   void add_node(std::size_t tag, const Vec3& x) {
     if (!node_index_.emplace(tag, coords_.size()).second) fail("node id " + std::to_string(tag) + " appears twice");
     coords_.push_back(x);
+    node_tags_.push_back(tag);
   }
 
   // Reads one coordinate; "nan" and "inf" are read as such so that validation can name the node.
@@ -192,30 +193,35 @@ class Parser {
     }
   }
 
-  /// Mesh of the triangles, with only the nodes they use (in Gmsh order) and promoted 3-node triangles.
+  /// Mesh of the triangles, with only the nodes they use (in file order) and promoted 3-node triangles.
   Mesh assemble() {
     if (triangles_.empty()) fail("has no triangles (Gmsh element type 2 or 9)");
+    // Gmsh node positions (file order) of every triangle node; unknown ids are an error.
+    std::vector<std::vector<std::size_t>> pos(triangles_.size());
+    std::vector<int> index(coords_.size(), -1);  // -1: no triangle uses the node
+    for (std::size_t e = 0; e < triangles_.size(); ++e)
+      for (std::size_t gmsh_node : triangles_[e].nodes) {
+        const auto it = node_index_.find(gmsh_node);
+        if (it == node_index_.end())
+          fail("element " + std::to_string(e) + " (gmsh id " + std::to_string(triangles_[e].tag) +
+               ") references unknown node id " + std::to_string(gmsh_node));
+        pos[e].push_back(it->second);
+        index[it->second] = 0;  // used by a triangle; numbered below
+      }
+    // Keep the used nodes in file order.
     Mesh mesh;
     MeshIds ids;
-    std::vector<int> index(coords_.size(), -1);
-    auto local = [&](std::size_t elem, std::size_t gmsh_node) {
-      const auto it = node_index_.find(gmsh_node);
-      if (it == node_index_.end())
-        fail("element " + std::to_string(elem) + " (gmsh id " + std::to_string(triangles_[elem].tag) +
-             ") references unknown node id " + std::to_string(gmsh_node));
-      int& i = index[it->second];
-      if (i < 0) {
-        i = static_cast<int>(mesh.nodes.size());
-        mesh.nodes.push_back(coords_[it->second]);
-        ids.nodes.push_back(gmsh_node);
+    for (std::size_t p = 0; p < coords_.size(); ++p)
+      if (index[p] == 0) {
+        index[p] = static_cast<int>(mesh.nodes.size());
+        mesh.nodes.push_back(coords_[p]);
+        ids.nodes.push_back(node_tags_[p]);
       }
-      return i;
-    };
     auto key = [](int a, int b) { return (std::uint64_t(std::min(a, b)) << 32) | std::uint64_t(std::max(a, b)); };
     std::unordered_map<std::uint64_t, int> midpoint;  // mid-side nodes of the 6-node triangles
     for (std::size_t e = 0; e < triangles_.size(); ++e) {
       std::array<int, 6> el{};
-      for (std::size_t k = 0; k < triangles_[e].nodes.size(); ++k) el[k] = local(e, triangles_[e].nodes[k]);
+      for (std::size_t k = 0; k < pos[e].size(); ++k) el[k] = index[pos[e][k]];
       if (triangles_[e].nodes.size() == 6)
         for (int k = 0; k < 3; ++k) midpoint.emplace(key(el[k], el[(k + 1) % 3]), el[3 + k]);
       mesh.elements.push_back(el);
@@ -245,7 +251,8 @@ class Parser {
   std::istream& in_;
   const std::string& label_;
   bool v4_ = false;
-  std::vector<Vec3> coords_;
+  std::vector<Vec3> coords_;  // in file order
+  std::vector<std::size_t> node_tags_;
   std::unordered_map<std::size_t, std::size_t> node_index_;
   std::vector<RawTriangle> triangles_;
 };
