@@ -166,19 +166,21 @@ std::vector<Check> ib_interpolation_order(bool quick) {
   const std::vector<int> sizes = quick ? std::vector<int>{16, 32, 64} : std::vector<int>{16, 32, 64, 128};
 
   for (const auto bcs : {Boundary::Periodic, Boundary::Wall}) {
-    for (const auto& kernel : kKernels) {
-      std::vector<double> errors;
-      for (const int n : sizes) {
-        const Grid g({n, n, n}, {1, 1, 1}, {bcs, bcs, bcs});
-        IBCoupler coupler(g, kernel);
-        coupler.interpolate_velocity(sample(g, smooth_velocity), X, U);
+    std::vector<double> errors[2];  // per kernel, coarsest grid first
+    for (const int n : sizes) {
+      const Grid g({n, n, n}, {1, 1, 1}, {bcs, bcs, bcs});
+      const FaceField u = sample(g, smooth_velocity);
+      for (int kk = 0; kk < 2; ++kk) {
+        IBCoupler(g, kKernels[kk]).interpolate_velocity(u, X, U);
         double e = 0;
         for (int l = 0; l < count; ++l) e = std::fmax(e, norm(U[l] - smooth_velocity(X[l])));
-        errors.push_back(e);
+        errors[kk].push_back(e);
       }
-      const std::string tag = kernel_name(kernel) + (bcs == Boundary::Wall ? ", walls" : ", periodic");
-      checks.push_back({tag + ": order of max interpolation error", min_observed_order(errors), ">=", 1.9});
-      checks.push_back({tag + ": max interpolation error, h = 1/" + std::to_string(sizes.back()), errors.back(),
+    }
+    for (int kk = 0; kk < 2; ++kk) {
+      const std::string tag = kernel_name(kKernels[kk]) + (bcs == Boundary::Wall ? ", walls" : ", periodic");
+      checks.push_back({tag + ": order of max interpolation error", min_observed_order(errors[kk]), ">=", 1.9});
+      checks.push_back({tag + ": max interpolation error, h = 1/" + std::to_string(sizes.back()), errors[kk].back(),
                         "<=", 1e-2});
     }
   }
