@@ -1,0 +1,195 @@
+#include "immerse/coupling/IBCoupler.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+#include <string>
+
+#include "immerse/coupling/NodeDiagnostics.hpp"
+
+namespace immerse {
+
+namespace {
+
+/// Coordinate of x along `axis` in index units of the faces (face = true) or cell centres,
+/// wrapped into [0, n] on periodic axes.
+double index_coordinate(const Grid& g, int axis, double x, bool face) {
+  double xr = x - g.origin()[axis];
+  if (g.periodic(axis)) {
+    const double L = g.length(axis);
+    xr -= L * std::floor(xr / L);
+  }
+  return xr / g.h() - (face ? 0.0 : 0.5);
+}
+
+/// The kernel weights of one node along one grid line: points idx[m] with weights w[m] for
+/// m in [lo, hi). Periodic axes wrap idx; on wall axes points outside the stored array are dropped.
+template <int W>
+struct LineStencil {
+  int lo, hi;
+  int idx[W];
+  double w[W];
+};
+
+template <class K>
+LineStencil<K::width> line_stencil(const Grid& g, int axis, double x, bool face) {
+  LineStencil<K::width> s;
+  const int i0 = K::weights(index_coordinate(g, axis, x, face), s.w);
+  const int n = g.n(axis);
+  if (g.periodic(axis)) {
+    s.lo = 0;
+    s.hi = K::width;
+    for (int m = 0; m < K::width; ++m) s.idx[m] = ((i0 + m) % n + n) % n;
+  } else {
+    const int count = face ? n + 1 : n;
+    s.lo = std::max(0, -i0);
+    s.hi = std::min(K::width, count - i0);
+    for (int m = 0; m < K::width; ++m) s.idx[m] = i0 + m;
+  }
+  return s;
+}
+
+/// The six line stencils of one node: line[a][1] for the faces normal to axis a, line[a][0]
+/// for the cell centres. Component d uses the face stencil along d and centres elsewhere.
+template <class K>
+struct NodeStencil {
+  LineStencil<K::width> line[3][2];
+  NodeStencil(const Grid& g, const Vec3& x) {
+    for (int a = 0; a < 3; ++a)
+      for (int face = 0; face < 2; ++face) line[a][face] = line_stencil<K>(g, a, x[a], face == 1);
+  }
+  const LineStencil<K::width>& along(int axis, int d) const { return line[axis][axis == d ? 1 : 0]; }
+};
+
+template <int W>
+void spread_component(const LineStencil<W>& sx, const LineStencil<W>& sy, const LineStencil<W>& sz, double Fd,
+                      Array3& f) {
+  const std::size_t nx = f.nx(), ny = f.ny();
+  double* p = f.data();
+  for (int kz = sz.lo; kz < sz.hi; ++kz) {
+    const double fz = Fd * sz.w[kz];
+    for (int ky = sy.lo; ky < sy.hi; ++ky) {
+      const double fyz = fz * sy.w[ky];
+      double* row = p + nx * (sy.idx[ky] + ny * sz.idx[kz]);
+      for (int kx = sx.lo; kx < sx.hi; ++kx) row[sx.idx[kx]] += fyz * sx.w[kx];
+    }
+  }
+}
+
+template <int W>
+double interpolate_component(const LineStencil<W>& sx, const LineStencil<W>& sy, const LineStencil<W>& sz,
+                             const Array3& u) {
+  const std::size_t nx = u.nx(), ny = u.ny();
+  const double* p = u.data();
+  double sum = 0.0;
+  for (int kz = sz.lo; kz < sz.hi; ++kz) {
+    double sum_y = 0.0;
+    for (int ky = sy.lo; ky < sy.hi; ++ky) {
+      const double* row = p + nx * (sy.idx[ky] + ny * sz.idx[kz]);
+      double sum_x = 0.0;
+      for (int kx = sx.lo; kx < sx.hi; ++kx) sum_x += sx.w[kx] * row[sx.idx[kx]];
+      sum_y += sy.w[ky] * sum_x;
+    }
+    sum += sz.w[kz] * sum_y;
+  }
+  return sum;
+}
+
+}  // namespace
+
+IBCoupler::IBCoupler(const Grid& grid, DeltaKernel kernel) : grid_(grid), kernel_(kernel) {
+  // Blocks one kernel width (or more) wide: a node's writes span at most width + 1 points
+  // from its first centre index, so two blocks of the same colour never touch the same point.
+  const int width = kernel_width(kernel_);
+  for (int b = 0; b < 2; ++b) {
+    const int n = grid_.n(b + 1);
+    const int count = (n / width) & ~1;
+    blocks_[b] = count >= 2 ? count : 1;
+    block_size_[b] = count >= 2 ? width : n + 1;
+  }
+  block_start_.assign(static_cast<std::size_t>(blocks_[0] * blocks_[1]) + 1, 0);
+}
+
+void IBCoupler::check_shape(const FaceField& field, const char* what) const {
+  for (int d = 0; d < 3; ++d)
+    if (field[d].shape() != grid_.face_shape(d))
+      throw std::invalid_argument(std::string("IBCoupler: ") + what + " is not shaped like the grid's faces");
+}
+
+template <class K>
+void IBCoupler::sort_into_blocks(std::span<const Vec3> X) {
+  const int n = static_cast<int>(X.size());
+  block_of_node_.resize(X.size());
+  block_nodes_.resize(X.size());
+  std::fill(block_start_.begin(), block_start_.end(), 0);
+#pragma omp parallel for
+  for (int l = 0; l < n; ++l) {
+    int block[2];
+    for (int b = 0; b < 2; ++b) {
+      const int axis = b + 1, na = grid_.n(axis);
+      int lo = std::min(K::first(index_coordinate(grid_, axis, X[l][axis], false)),
+                        K::first(index_coordinate(grid_, axis, X[l][axis], true)));
+      lo = grid_.periodic(axis) ? (lo % na + na) % na : std::clamp(lo, 0, na - 1);
+      block[b] = std::min(lo / block_size_[b], blocks_[b] - 1);
+    }
+    block_of_node_[l] = block[0] + blocks_[0] * block[1];
+  }
+  // Counting sort, stable: each block keeps its nodes in index order.
+  for (int l = 0; l < n; ++l) ++block_start_[block_of_node_[l] + 1];
+  for (std::size_t b = 1; b < block_start_.size(); ++b) block_start_[b] += block_start_[b - 1];
+  for (int l = 0; l < n; ++l) block_nodes_[block_start_[block_of_node_[l]]++] = l;
+  for (std::size_t b = block_start_.size() - 1; b > 0; --b) block_start_[b] = block_start_[b - 1];
+  block_start_[0] = 0;
+}
+
+template <class K>
+void IBCoupler::spread(std::span<const Vec3> X, std::span<const Vec3> F, FaceField& f) {
+  sort_into_blocks<K>(X);
+  for (int d = 0; d < 3; ++d) {
+    double* p = f[d].data();
+    const long size = static_cast<long>(f[d].size());
+#pragma omp parallel for
+    for (long i = 0; i < size; ++i) p[i] = 0.0;
+  }
+  const double inv_h3 = 1.0 / grid_.cell_volume();
+  for (int colour = 0; colour < 4; ++colour) {
+    const int cy = colour % 2, cz = colour / 2;
+    const int my = (blocks_[0] - cy + 1) / 2, mz = (blocks_[1] - cz + 1) / 2;
+#pragma omp parallel for schedule(dynamic, 1)
+    for (int m = 0; m < my * mz; ++m) {
+      const int b = (cy + 2 * (m % my)) + blocks_[0] * (cz + 2 * (m / my));
+      for (int p = block_start_[b]; p < block_start_[b + 1]; ++p) {
+        const int l = block_nodes_[p];
+        const NodeStencil<K> s(grid_, X[l]);
+        for (int d = 0; d < 3; ++d)
+          spread_component(s.along(0, d), s.along(1, d), s.along(2, d), F[l][d] * inv_h3, f[d]);
+      }
+    }
+  }
+}
+
+template <class K>
+void IBCoupler::interpolate(const FaceField& u, std::span<const Vec3> X, std::span<Vec3> U) const {
+  const long n = static_cast<long>(X.size());
+#pragma omp parallel for
+  for (long l = 0; l < n; ++l) {
+    const NodeStencil<K> s(grid_, X[l]);
+    for (int d = 0; d < 3; ++d) U[l][d] = interpolate_component(s.along(0, d), s.along(1, d), s.along(2, d), u[d]);
+  }
+}
+
+void IBCoupler::spread_force(std::span<const Vec3> X, std::span<const Vec3> F, FaceField& f) {
+  if (F.size() != X.size()) throw std::invalid_argument("IBCoupler::spread_force: X and F differ in length");
+  check_shape(f, "the force field");
+  check_nodes_in_domain(grid_, X);
+  std::visit([&](const auto& k) { spread<std::decay_t<decltype(k)>>(X, F, f); }, kernel_);
+}
+
+void IBCoupler::interpolate_velocity(const FaceField& u, std::span<const Vec3> X, std::span<Vec3> U) const {
+  if (U.size() != X.size()) throw std::invalid_argument("IBCoupler::interpolate_velocity: X and U differ in length");
+  check_shape(u, "the velocity field");
+  check_nodes_in_domain(grid_, X);
+  std::visit([&](const auto& k) { interpolate<std::decay_t<decltype(k)>>(u, X, U); }, kernel_);
+}
+
+}  // namespace immerse

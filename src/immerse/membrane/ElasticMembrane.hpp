@@ -1,0 +1,95 @@
+#pragma once
+// Elastic forces of a closed capsule membrane of six-node curved triangles (paper §2.3, §3, eqs. 15-27, 38-42).
+//
+// In-plane: the law W(A1, A2) (MaterialLaw) gives the tension tau (18) from B = A A^T (17), A from (39).
+// Bending:  m = kappa_B (kappa - kappa_m^R P) (25), kappa from (40), K = (P.grad) m from (41), q from (27).
+// Two ways to turn these into nodal forces (newtons, ready for spreading with eq. 6):
+//   ForceMethod::Contour  eq. (42): per element F_e = oint [b.tau + (b.q) n] dl along the three curved edges
+//                         (3-point Gauss on each quadratic edge), with tau, q, n interpolated from nodal values
+//                         that are averages over the elements sharing a node. F_e = S_e fbar_e is then shared
+//                         among the element's six nodes in proportion to their lumped areas (node_area).
+//   ForceMethod::Energy   F_i = -dE/dX_i of E = sum_e sum_gp W(A1, A2) Jbar w (6-point rule on each curved
+//                         element, A from the element's own interpolation): exact linear and angular momentum.
+//                         Bending (if kappa_B > 0) is added as the q-part of eq. (42); E holds no bending energy.
+// See docs/membrane-bending.md for the derivations, the lumping rule and the one deviation from the paper
+// (element-node tensions, not deformation gradients, are averaged at nodes).
+#include <cstddef>
+#include <vector>
+
+#include "immerse/core/Vec3.hpp"
+#include "immerse/membrane/MaterialLaw.hpp"
+#include "immerse/membrane/Mesh.hpp"
+
+namespace immerse {
+
+enum class ForceMethod { Contour, Energy };
+
+/// Reference mean curvature kappa_m^R of eq. (25): zero, or per node that of the reference (rest) shape.
+enum class ReferenceCurvature { Zero, RestShape };
+
+struct Bending {
+  double kappa_B = 0;  ///< bending modulus, J (N m); 0 switches bending off
+  ReferenceCurvature reference = ReferenceCurvature::Zero;
+};
+
+/// Per-node strain and tension for output: invariants (19)-(20), principal stretches and principal tensions.
+struct NodeStrain {
+  double A1, A2;
+  double lambda1, lambda2;  ///< lambda1 >= lambda2
+  double tau1, tau2;        ///< principal tensions, N/m, tau1 >= tau2
+};
+
+class ElasticMembrane {
+ public:
+  /// `reference` holds the unstressed positions Xbar (indexed like mesh.nodes). InputError on size mismatch,
+  /// bad element indices, kappa_B < 0 or a degenerate reference element.
+  ElasticMembrane(const Mesh& mesh, std::vector<Vec3> reference, MaterialLaw law, Bending bending,
+                  ForceMethod method);
+
+  /// Nodal forces F (N) exerted by the membrane at positions X (resized to the node count). Thread-safe for
+  /// concurrent calls; OpenMP inside; independent of the thread count. SimulationError naming the element if
+  /// one inverts or degenerates (Jacobian <= 0 or not finite).
+  void compute_force(const std::vector<Vec3>& X, std::vector<Vec3>& F) const;
+  /// Discrete in-plane elastic energy E (J) = sum_e sum_gp W(A1, A2) Jbar w.
+  double compute_energy(const std::vector<Vec3>& X) const;
+
+  /// Strain and tension at each node (element-node values averaged over the elements sharing the node).
+  std::vector<NodeStrain> node_strain(const std::vector<Vec3>& X) const;
+  /// Lumped area a_i (m^2) each node carries at X; sum_i a_i = total area. Force density at node i = F_i / a_i
+  /// for the contour method.
+  std::vector<double> node_area(const std::vector<Vec3>& X) const;
+  /// Unit normal at each node: normalized average of the normals of the elements sharing it.
+  std::vector<Vec3> node_normal(const std::vector<Vec3>& X) const;
+  /// kappa_m^R of eq. (25) per node (1/m).
+  const std::vector<double>& reference_curvature() const { return kappa_ref_; }
+
+  std::size_t num_nodes() const { return reference_.size(); }
+  std::size_t num_elements() const { return elements_.size(); }
+  ForceMethod method() const { return method_; }
+  /// Bytes held by this object (reference data, incidence) plus the workspace one compute_force allocates.
+  std::size_t memory_bytes() const;
+
+ private:
+  struct Work;
+  void check_size(const std::vector<Vec3>& X) const;
+  void element_node_pass(const std::vector<Vec3>& X, bool with_tension, Work& w) const;
+  void curvature_pass(const std::vector<Vec3>& X, Work& w) const;
+  void bending_passes(const std::vector<Vec3>& X, Work& w) const;
+  void contour_forces(const std::vector<Vec3>& X, bool with_tension, bool with_bending, Work& w) const;
+  void energy_forces(const std::vector<Vec3>& X, Work& w) const;
+  void gather(const std::vector<Vec3>& en, std::vector<Vec3>& node) const;
+  std::vector<double> reference_mean_curvature() const;
+
+  std::vector<std::array<int, 6>> elements_;
+  std::vector<Vec3> reference_;
+  MaterialLaw law_;
+  Bending bending_;
+  ForceMethod method_;
+  std::vector<int> inc_start_;  ///< node i's element-node slots are inc_[inc_start_[i] .. inc_start_[i+1])
+  std::vector<int> inc_;        ///< slot 6 e + k: element e, local node k; ascending in e
+  std::vector<double> ref_node_;  ///< per element node: Gbar^{xx}, Gbar^{xe}, Gbar^{ee}, Jbar (4 doubles)
+  std::vector<double> ref_quad_;  ///< per quadrature point: Gbar^{xx}, Gbar^{xe}, Gbar^{ee}, Jbar w
+  std::vector<double> kappa_ref_;
+};
+
+}  // namespace immerse

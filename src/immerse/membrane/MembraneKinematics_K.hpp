@@ -1,0 +1,114 @@
+#pragma once
+// Pointwise kinematics of a curved membrane element (paper §2.3, §3). Each function works on the tangent
+// vectors a_xi = dX/dxi, a_eta = dX/deta at one parametric point; the element loops live in ElasticMembrane.
+//
+//   dual basis       a^xi = (a_eta x n)/J, a^eta = (n x a_xi)/J,  J = |a_xi x a_eta|,  n = a_xi x a_eta / J
+//   eq. (39)         A . abar_xi = a_xi, A . abar_eta = a_eta, A . nbar = 0   =>   A = a_alpha (x) abar^alpha
+//   eq. (17)         B = A A^T = Gbar^{alpha beta} a_alpha (x) a_beta,  Gbar^{alpha beta} = abar^alpha . abar^beta
+//   eq. (19)         A1 = ln(lambda1 lambda2) = ln(J / Jbar)
+//   eq. (20)         A2 = tr(B)/2 - 1
+//   eq. (18)         tau = e^{-A1} (dW/dA1 P + dW/dA2 B),  P = I - n n
+//   eq. (40)         a_xi . kappa = dn/dxi, a_eta . kappa = dn/deta, n . kappa = 0  =>  kappa = a^alpha (x) dn/dalpha
+//   eqs. (41), (27)  K = a^alpha (x) dm/dalpha,  (P.grad).m = K_iik = a^alpha . dm/dalpha,  q = [(P.grad).m] . P
+// Energy gradient at a quadrature point (ElasticMembrane, energy method):
+//   dA1/da_alpha = a^alpha,  dA2/da_alpha = Gbar^{alpha beta} a_beta = A abar^alpha,
+//   dW/da_alpha = dW/dA1 a^alpha + dW/dA2 Gbar^{alpha beta} a_beta.
+#include <array>
+#include <cmath>
+
+#include "immerse/core/Mat3.hpp"
+#include "immerse/core/Vec3.hpp"
+#include "immerse/membrane/EnergyDensity.hpp"
+#include "immerse/membrane/QuadraticTriangle_K.hpp"
+
+namespace immerse::membrane_k {
+
+using Nodes = std::array<Vec3, tri6::kNodes>;
+
+struct Tangents {
+  Vec3 a_xi, a_eta;
+};
+
+/// a_alpha = sum_i x_i dN_i/dalpha (eq. 38 differentiated).
+inline Tangents tangents(const Nodes& x, const tri6::Shape& s) {
+  Tangents t;
+  for (int i = 0; i < tri6::kNodes; ++i) {
+    t.a_xi += s.dxi[i] * x[i];
+    t.a_eta += s.deta[i] * x[i];
+  }
+  return t;
+}
+
+/// Unit normal, area Jacobian and dual (contravariant) tangent basis at a point.
+struct Frame {
+  Vec3 n;
+  double J;
+  Vec3 d_xi, d_eta;  ///< a^xi, a^eta: a^alpha . a_beta = delta, a^alpha . n = 0
+};
+
+inline Frame frame(const Tangents& t) {
+  const Vec3 c = cross(t.a_xi, t.a_eta);
+  const double J = norm(c);
+  const Vec3 n = c / J;
+  return {n, J, cross(t.a_eta, n) / J, cross(n, t.a_xi) / J};
+}
+
+/// Reference-configuration data a point needs: contravariant metric Gbar^{alpha beta} and Jacobian Jbar.
+struct RefMetric {
+  double g_xx, g_xe, g_ee, J;
+};
+
+inline RefMetric ref_metric(const Tangents& t) {
+  const Frame f = frame(t);
+  return {dot(f.d_xi, f.d_xi), dot(f.d_xi, f.d_eta), dot(f.d_eta, f.d_eta), f.J};
+}
+
+/// Eq. (39) solved in closed form: A = a_xi (x) abar^xi + a_eta (x) abar^eta.
+inline Mat3 deformation_gradient(const Tangents& t, const Frame& ref) {
+  return Mat3::outer(t.a_xi, ref.d_xi) + Mat3::outer(t.a_eta, ref.d_eta);
+}
+
+/// Left Cauchy-Green tensor B = A A^T (17) through the reference metric.
+inline Mat3 left_cauchy_green(const Tangents& t, const RefMetric& g) {
+  const Mat3 xe = Mat3::outer(t.a_xi, t.a_eta);
+  return g.g_xx * Mat3::outer(t.a_xi, t.a_xi) + g.g_ee * Mat3::outer(t.a_eta, t.a_eta) +
+         g.g_xe * (xe + transpose(xe));
+}
+
+/// Strain invariants (19), (20) at a point with current Jacobian J.
+struct Invariants {
+  double A1, A2;
+};
+
+inline Invariants invariants(const Tangents& t, double J, const RefMetric& g) {
+  const double A2 = 0.5 * (g.g_xx * dot(t.a_xi, t.a_xi) + 2 * g.g_xe * dot(t.a_xi, t.a_eta) +
+                           g.g_ee * dot(t.a_eta, t.a_eta)) - 1;
+  return {std::log(J / g.J), A2};
+}
+
+/// Tension tensor (18).
+inline Mat3 tension(const EnergyDensity& w, double A1, const Mat3& B, const Vec3& n) {
+  return std::exp(-A1) * (w.dW_dA1 * (Mat3::identity() - Mat3::outer(n, n)) + w.dW_dA2 * B);
+}
+
+/// Curvature tensor (40) from the parametric derivatives of the normal field.
+inline Mat3 curvature(const Frame& f, const Vec3& dn_dxi, const Vec3& dn_deta) {
+  return Mat3::outer(f.d_xi, dn_dxi) + Mat3::outer(f.d_eta, dn_deta);
+}
+
+/// Surface divergence of the moment tensor, (P.grad).m = tr K with K from (41).
+inline Vec3 moment_divergence(const Frame& f, const Mat3& dm_dxi, const Mat3& dm_deta) {
+  return f.d_xi * dm_dxi + f.d_eta * dm_deta;
+}
+
+/// Energy gradient dW/da_alpha at a point (see header).
+struct EnergyGradient {
+  Vec3 d_xi, d_eta;
+};
+
+inline EnergyGradient energy_gradient(const EnergyDensity& w, const Tangents& t, const Frame& f, const RefMetric& g) {
+  return {w.dW_dA1 * f.d_xi + w.dW_dA2 * (g.g_xx * t.a_xi + g.g_xe * t.a_eta),
+          w.dW_dA1 * f.d_eta + w.dW_dA2 * (g.g_xe * t.a_xi + g.g_ee * t.a_eta)};
+}
+
+}  // namespace immerse::membrane_k
