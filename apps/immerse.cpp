@@ -3,6 +3,7 @@
 #include <iostream>
 
 #include "immerse/core/Error.hpp"
+#include "immerse/timestep/PetscSession.hpp"
 #include "immerse/verify/Runner.hpp"
 
 namespace {
@@ -44,6 +45,7 @@ int main(int argc, char** argv) {
     return app.exit(e) == 0 ? 0 : 2;
   }
   try {
+    immerse::PetscSession petsc;
     if (*verify) return run_verify(study, quick);
   } catch (const immerse::InputError& e) {
     std::cerr << "immerse: error: " << e.what() << "\n";

@@ -11,7 +11,7 @@ bool Check::pass() const {
 
 std::vector<Study> all_studies() {
   std::vector<Study> all;
-  for (auto&& part : {fluid_studies(), membrane_studies(), coupling_studies()})
+  for (auto&& part : {fluid_studies(), membrane_studies(), coupling_studies(), integrator_studies()})
     all.insert(all.end(), part.begin(), part.end());
   return all;
 }

@@ -30,5 +30,6 @@ std::vector<Study> all_studies();
 std::vector<Study> fluid_studies();
 std::vector<Study> membrane_studies();
 std::vector<Study> coupling_studies();
+std::vector<Study> integrator_studies();
 
 }  // namespace immerse::verify
