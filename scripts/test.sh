@@ -6,5 +6,5 @@ cd "$(dirname "$0")/.."
 export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 OMPI_MCA_plm=isolated
 for preset in release debug; do
   bash scripts/build.sh "$preset"
-  ctest --preset "$preset" -j "$(nproc)"
+  ctest --preset "$preset"
 done
