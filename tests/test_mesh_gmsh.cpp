@@ -112,8 +112,10 @@ TEST(GmshReader, ReadsQuadraticTrianglesExactly) {
 TEST(GmshReader, ReadsFormat41) {
   std::ostringstream s;
   s << "$MeshFormat\n4.1 0 8\n$EndMeshFormat\n$Entities\n0 0 1 0\n1 -1 -1 -1 1 1 1 0 0\n$EndEntities\n";
-  s << "$Nodes\n2 6 1 6\n0 1 0 1\n1\n1 0 0\n2 1 0 5\n2\n3\n4\n5\n6\n";
-  for (int i = 1; i < 6; ++i) s << kOctNodes[i][0] << " " << kOctNodes[i][1] << " " << kOctNodes[i][2] << "\n";
+  // Second node block on a surface entity with parametric coordinates (u, v) after x y z.
+  s << "$Nodes\n2 6 1 6\n0 1 0 1\n1\n1 0 0\n2 1 1 5\n2\n3\n4\n5\n6\n";
+  for (int i = 1; i < 6; ++i)
+    s << kOctNodes[i][0] << " " << kOctNodes[i][1] << " " << kOctNodes[i][2] << " 0.25 0.5\n";
   s << "$EndNodes\n$Elements\n2 9 1 9\n0 1 15 1\n1 1\n2 1 2 8\n";
   for (std::size_t e = 0; e < kOctFaces.size(); ++e)
     s << 2 + e << " " << kOctFaces[e][0] << " " << kOctFaces[e][1] << " " << kOctFaces[e][2] << "\n";

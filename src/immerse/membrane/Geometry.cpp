@@ -20,10 +20,11 @@ Vec3 mean_position(const std::vector<Vec3>& X) {
   return X.empty() ? s : s / static_cast<double>(X.size());
 }
 
-/// Curved areas of the four sub-triangles (v0 m01 m20), (m01 v1 m12), (m20 m12 v2), (m01 m12 m20) of an
-/// element, each by the 7-point rule mapped affinely onto the sub-triangle (Jacobian 1/4).
+/// The four sub-triangles (v0 m01 m20), (m01 v1 m12), (m20 m12 v2), (m01 m12 m20) as local node numbers.
 constexpr std::array<std::array<int, 3>, 4> kSubTriangles{{{0, 3, 5}, {3, 1, 4}, {5, 4, 2}, {3, 4, 5}}};
 
+/// Curved areas of an element's four sub-triangles, each by the 7-point rule mapped affinely onto the
+/// sub-triangle in parent coordinates (Jacobian 1/4).
 std::array<double, 4> sub_triangle_areas(const MeshElement::Nodes& x) {
   std::array<double, 4> a{};
   for (int k = 0; k < 4; ++k) {
@@ -67,17 +68,21 @@ VolumeMoments volume_moments(const Mesh& mesh, const std::vector<Vec3>& X, const
   return sum;
 }
 
-/// Second moment ∫ r rᵀ dV about the volume centroid, and the centroid.
-std::pair<Mat3, Vec3> central_second_moment(const Mesh& mesh, const std::vector<Vec3>& X, double& vol) {
+/// Volume, volume centroid and second moment ∫ r rᵀ dV about the centroid.
+struct CentralMoments {
+  double volume;
+  Vec3 centroid;
+  Mat3 second;
+};
+
+CentralMoments central_moments(const Mesh& mesh, const std::vector<Vec3>& X) {
   const Vec3 origin = mean_position(X);
   const VolumeMoments m = volume_moments(mesh, X, origin);
-  vol = m.m0;
   const Vec3 c = m.m1 / m.m0;
-  return {m.m2 - m.m0 * Mat3::outer(c, c), origin + c};
+  return {m.m0, origin + c, m.m2 - m.m0 * Mat3::outer(c, c)};
 }
 
-/// Eigen-pairs of a symmetric 3×3 matrix by cyclic Jacobi rotations; columns of `vectors` are the
-/// eigenvectors, values sorted in decreasing order.
+/// Eigen-pairs of a symmetric 3×3 matrix by cyclic Jacobi rotations, values in decreasing order.
 struct SymmetricEigen {
   std::array<double, 3> values;
   std::array<Vec3, 3> vectors;
@@ -127,17 +132,17 @@ double volume(const Mesh& mesh, const std::vector<Vec3>& X) {
 }
 
 Mat3 inertia_tensor(const Mesh& mesh, const std::vector<Vec3>& X) {
-  double vol = 0;
-  const Mat3 m = central_second_moment(mesh, X, vol).first;
+  const Mat3 m = central_moments(mesh, X).second;
   return trace(m) * Mat3::identity() - m;
 }
 
 MembraneGeometry measure(const Mesh& mesh, const std::vector<Vec3>& X) {
+  const CentralMoments m = central_moments(mesh, X);
   MembraneGeometry g;
-  const auto [m, c] = central_second_moment(mesh, X, g.volume);
-  g.centroid = c;
+  g.volume = m.volume;
+  g.centroid = m.centroid;
   g.area = area(mesh, X);
-  const SymmetricEigen eig = symmetric_eigen(m);
+  const SymmetricEigen eig = symmetric_eigen(m.second);
   for (int k = 0; k < 3; ++k) {
     g.semi_axes[k] = std::sqrt(5 * std::max(eig.values[k], 0.0) / g.volume);
     g.axes[k] = eig.vectors[k];

@@ -142,15 +142,15 @@ class Parser {
     next<std::size_t>("$Nodes header");
     next<std::size_t>("$Nodes header");
     for (std::size_t b = 0; b < blocks; ++b) {
+      const int dim = next<int>("$Nodes block header");
       next<int>("$Nodes block header");
-      next<int>("$Nodes block header");
-      const int parametric = next<int>("$Nodes block header");
+      const int parametric = next<int>("$Nodes block header");  // then each node has `dim` parametric coordinates
       const auto n = next<std::size_t>("$Nodes block header");
       std::vector<std::size_t> tags(n);
       for (auto& t : tags) t = next<std::size_t>("$Nodes block tags");
       for (auto t : tags) {
         add_node(t, point(t));
-        for (int k = 0; k < parametric * 2; ++k) next<double>("$Nodes parametric coordinates");
+        for (int k = 0; k < (parametric ? dim : 0); ++k) next<double>("$Nodes parametric coordinates");
       }
     }
   }
