@@ -16,11 +16,12 @@ struct MacGeom {
   std::array<int, 3> n{};
   std::array<bool, 3> periodic{};
   double h = 1;
+  double inv_h = 1, inv_h2 = 1;  // 1/h, 1/h²
   std::array<Vec3, 3> wall_lower{};  ///< velocity of the lower wall of each wall axis (zero: homogeneous)
   std::array<Vec3, 3> wall_upper{};
 
   /// Homogeneous walls (all wall velocities zero): the operators the fast solvers invert.
-  explicit MacGeom(const Grid& g) : n(g.n()), h(g.h()) {
+  explicit MacGeom(const Grid& g) : n(g.n()), h(g.h()), inv_h(1 / g.h()), inv_h2(1 / (g.h() * g.h())) {
     for (int a = 0; a < 3; ++a) periodic[a] = g.periodic(a);
   }
   MacGeom(const Grid& g, const FluidParams& p) : MacGeom(g) {

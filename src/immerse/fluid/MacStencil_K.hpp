@@ -35,6 +35,10 @@ inline double face_value(const Array3& ue, const MacGeom& g, int e, const Index&
 /// Component d at the neighbour s = ±1 along axis e of its face q (periodic wrap, wall value or ghost).
 inline double neighbor(const Array3& ud, const MacGeom& g, int d, Index q, int e, int s) {
   const int m = q[e] + s;
+  if (m > 0 && m < g.n[e]) {  // interior (the common case)
+    q[e] = m;
+    return at(ud, q);
+  }
   if (g.periodic[e]) {
     q[e] = wrap(m, g.n[e]);
     return at(ud, q);
@@ -47,12 +51,31 @@ inline double neighbor(const Array3& ud, const MacGeom& g, int d, Index q, int e
   return 2.0 * uw - at(ud, q);
 }
 
+/// Face q of component d with its six neighbours: minus[e] at −e, plus[e] at +e.
+struct FaceStencil {
+  double centre;
+  double minus[3], plus[3];
+};
+
+inline FaceStencil gather(const Array3& ud, const MacGeom& g, int d, const Index& q) {
+  FaceStencil st{at(ud, q), {}, {}};
+  for (int e = 0; e < 3; ++e) {
+    st.minus[e] = neighbor(ud, g, d, q, e, -1);
+    st.plus[e] = neighbor(ud, g, d, q, e, +1);
+  }
+  return st;
+}
+
+/// ∇_h² u_d from its stencil.
+inline double laplacian(const FaceStencil& st, const MacGeom& g) {
+  double s = 0;
+  for (int e = 0; e < 3; ++e) s += st.minus[e] - 2.0 * st.centre + st.plus[e];
+  return s * g.inv_h2;
+}
+
 /// ∇_h² u_d at face q of component d, with the boundary values of g.
 inline double laplacian_face(const Array3& ud, const MacGeom& g, int d, const Index& q) {
-  const double c = at(ud, q);
-  double s = 0;
-  for (int e = 0; e < 3; ++e) s += neighbor(ud, g, d, q, e, -1) - 2.0 * c + neighbor(ud, g, d, q, e, +1);
-  return s / (g.h * g.h);
+  return laplacian(gather(ud, g, d, q), g);
 }
 
 /// Part of ∇_h² u_d at face q that comes from the wall velocities alone (∇_h² with walls minus ∇_h² with
@@ -66,17 +89,15 @@ inline double wall_source_face(const MacGeom& g, int d, const Index& q) {
     if (q[e] == lo) s += f * g.wall_lower[e][d];
     if (q[e] == hi) s += f * g.wall_upper[e][d];
   }
-  return s / (g.h * g.h);
+  return s * g.inv_h2;
 }
 
 /// Central-difference advection (u·∇_h u)_d at face q: Σ_e ū_e (u_d(q+e) − u_d(q−e)) / 2h, where ū_e is the
-/// mean of the four e-faces around face q (ū_d = u_d).
-inline double advection_face(const FaceField& u, const MacGeom& g, int d, const Index& q) {
-  const Array3& ud = u[d];
+/// mean of the four e-faces around face q (ū_d = u_d); st is the stencil of u_d at q.
+inline double advection_face(const FaceField& u, const MacGeom& g, int d, const Index& q, const FaceStencil& st) {
   double a = 0;
   for (int e = 0; e < 3; ++e) {
-    const double grad = (neighbor(ud, g, d, q, e, +1) - neighbor(ud, g, d, q, e, -1)) / (2.0 * g.h);
-    double ue = at(ud, q);
+    double ue = st.centre;
     if (e != d) {
       Index r = q;
       const int dm = g.periodic[d] ? wrap(q[d] - 1, g.n[d]) : q[d] - 1;
@@ -90,16 +111,16 @@ inline double advection_face(const FaceField& u, const MacGeom& g, int d, const 
       sum += face_value(u[e], g, e, r);
       ue = 0.25 * sum;
     }
-    a += ue * grad;
+    a += ue * (st.plus[e] - st.minus[e]);
   }
-  return a;
+  return 0.5 * g.inv_h * a;
 }
 
 /// (G^MAC p)_d at face q (an unknown face: never a wall face).
 inline double gradient_face(const Array3& p, const MacGeom& g, int d, const Index& q) {
   Index r = q;
   r[d] = g.periodic[d] ? wrap(q[d] - 1, g.n[d]) : q[d] - 1;
-  return (at(p, q) - at(p, r)) / g.h;
+  return (at(p, q) - at(p, r)) * g.inv_h;
 }
 
 /// (D^MAC u) at cell q, from the face values stored in u (wall faces included).
@@ -110,7 +131,7 @@ inline double divergence_cell(const FaceField& u, const MacGeom& g, const Index&
     r[d] = g.periodic[d] ? wrap(q[d] + 1, g.n[d]) : q[d] + 1;
     s += at(u[d], r) - at(u[d], q);
   }
-  return s / g.h;
+  return s * g.inv_h;
 }
 
 /// D^MAC G^MAC φ at cell q: the 7-point Laplacian with ghost φ_g = φ_0 at walls (homogeneous Neumann).
@@ -125,7 +146,7 @@ inline double laplacian_cell_neumann(const Array3& phi, const MacGeom& g, const 
       else if (m >= 0 && m < g.n[e]) r[e] = m;
       s += at(phi, r) - c;
     }
-  return s / (g.h * g.h);
+  return s * g.inv_h2;
 }
 
 }  // namespace immerse::mac

@@ -68,6 +68,7 @@ void NavierStokesSolver::step(const FluidState& in, const FaceField& force, doub
   const bool first = in.step == 0 || in.dt_prev <= 0;
   const double r = first ? 0.0 : dt / in.dt_prev;
   const double w_now = 1.0 + 0.5 * r, w_old = -0.5 * r;
+  const double dt_rho = dt / rho;
 
   for (int d = 0; d < 3; ++d) {
     const Array3 &un = in.u[d], &adv_old = in.adv[d], &f = force[d];
@@ -75,15 +76,13 @@ void NavierStokesSolver::step(const FluidState& in, const FaceField& force, doub
     const double fb = params_.body_force[d];
     for_each_face(g, d, [&](int i, int j, int k) {
       const mac::Index q{i, j, k};
-      const double a_now = mac::advection_face(in.u, g, d, q);
+      const mac::FaceStencil st = mac::gather(un, g, d, q);
+      const double a_now = mac::advection_face(in.u, g, d, q, st);
       adv(i, j, k) = a_now;
       const double a = w_now * a_now + w_old * adv_old(i, j, k);
       // (9) with the implicit half of the viscous term on the left; its wall values move to the right.
-      rhs(i, j, k) = un(i, j, k) +
-                     dt / rho *
-                         (-rho * a - mac::gradient_face(in.p, g, d, q) +
-                          0.5 * mu * (mac::laplacian_face(un, g, d, q) + mac::wall_source_face(g, d, q)) + f(i, j, k) +
-                          fb);
+      const double visc = 0.5 * mu * (mac::laplacian(st, g) + mac::wall_source_face(g, d, q));
+      rhs(i, j, k) = un(i, j, k) + dt_rho * (-rho * a - mac::gradient_face(in.p, g, d, q) + visc + f(i, j, k) + fb);
     });
     solvers_[d]->solve(rhs, 1.0, -c);
   }
@@ -102,7 +101,7 @@ void NavierStokesSolver::step(const FluidState& in, const FaceField& force, doub
     const Array3& us = ustar_[d];
     Array3& un1 = out.u[d];
     for_each_face(g, d, [&](int i, int j, int k) {
-      un1(i, j, k) = us(i, j, k) - dt / rho * mac::gradient_face(phi_, g, d, {i, j, k});
+      un1(i, j, k) = us(i, j, k) - dt_rho * mac::gradient_face(phi_, g, d, {i, j, k});
     });
   }
   apply_wall_values(out.u);
