@@ -1,0 +1,75 @@
+// Cost of one fluid step (paper eqs. 9–13: three Helmholtz solves, one Poisson solve, explicit stencils) on
+//   - a 64³ periodic box, and
+//   - a 64×128×32 box with walls on y and z, periodic along x,
+// with 1 and 2 threads. Counters: ratio_to_transforms = step time / time of the FFTW transforms alone that the
+// step performs (4 forward + 4 backward), speedup = (1-thread step time) / (this step time).
+#include <benchmark/benchmark.h>
+#include <omp.h>
+
+#include <array>
+#include <chrono>
+#include <map>
+#include <random>
+
+#include "immerse/fluid/NavierStokesSolver.hpp"
+
+using namespace immerse;
+
+namespace {
+
+Grid bench_grid(int which) {
+  constexpr Boundary P = Boundary::Periodic, W = Boundary::Wall;
+  if (which == 0) return Grid({64, 64, 64}, {1, 1, 1}, {P, P, P});
+  return Grid({64, 128, 32}, {1, 2, 0.5}, {P, W, W});
+}
+
+// Seconds per call of f, averaged over enough repetitions.
+template <class F>
+double seconds_per_call(F&& f, int reps) {
+  const auto t0 = std::chrono::steady_clock::now();
+  for (int r = 0; r < reps; ++r) f();
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count() / reps;
+}
+
+std::map<int, double>& one_thread_step_time() {
+  static std::map<int, double> t;
+  return t;
+}
+
+void BM_FluidStep(benchmark::State& state) {
+  const int which = static_cast<int>(state.range(0));
+  const int threads = static_cast<int>(state.range(1));
+  omp_set_num_threads(threads);
+  const Grid g = bench_grid(which);
+  FluidParams prm;
+  prm.rho = 1;
+  prm.mu = 0.01;
+  prm.body_force = {1, 0, 0};
+  prm.wall_upper[2] = {0.5, 0, 0};
+  NavierStokesSolver ns(g, prm, FftPlanning::Measure);
+  FluidState a = ns.initial_state(), b;
+  std::mt19937 rng(1);
+  std::uniform_real_distribution<double> U(-1, 1);
+  for (int d = 0; d < 3; ++d)
+    for (double& v : a.u[d].values()) v = U(rng);
+  ns.apply_wall_values(a.u);
+  const FaceField force(g);
+  ns.step(a, force, 1e-3, b);  // first call sizes `b`
+  for (auto _ : state) ns.step(a, force, 1e-3, b);
+
+  const double step = seconds_per_call([&] { ns.step(a, force, 1e-3, b); }, 5);
+  const double transforms = seconds_per_call(
+      [&] {
+        for (int l = 0; l < 4; ++l) ns.fast_solver(static_cast<Layout>(l)).transform_round_trip();
+      },
+      5);
+  if (threads == 1) one_thread_step_time()[which] = step;
+  state.counters["ratio_to_transforms"] = step / transforms;
+  if (one_thread_step_time().count(which)) state.counters["speedup"] = one_thread_step_time()[which] / step;
+  state.SetLabel(which == 0 ? "64^3 periodic" : "64x128x32, walls y,z");
+}
+
+}  // namespace
+
+BENCHMARK(BM_FluidStep)->ArgsProduct({{0, 1}, {1, 2}})->ArgNames({"grid", "threads"})->Unit(benchmark::kMillisecond);
+BENCHMARK_MAIN();

@@ -1,0 +1,117 @@
+#include "immerse/fluid/FastSolver.hpp"
+
+#include <fftw3.h>
+#include <omp.h>
+
+#include <cmath>
+#include <mutex>
+#include <numbers>
+#include <stdexcept>
+
+namespace immerse {
+
+namespace {
+
+// FFTW's threading must be initialized once per process before any plan is made.
+void init_fftw_threads() {
+  static std::once_flag once;
+  std::call_once(once, [] {
+    fftw_init_threads();
+    fftw_make_planner_thread_safe();
+  });
+}
+
+}  // namespace
+
+FastSolver::FastSolver(const Grid& grid, Layout layout, FftPlanning planning) : layout_(layout) {
+  init_fftw_threads();
+  const int comp = static_cast<int>(layout);  // 3: pressure
+  const double h = grid.h();
+  std::array<fftw_r2r_kind, 3> fwd{}, bwd{};
+  for (int a = 0; a < 3; ++a) {
+    const int n = grid.n(a);
+    double shift = 0;  // eigen frequency of slot s is s + shift; the period is `period` slots
+    double period = n;
+    if (grid.periodic(a)) {
+      m_[a] = n;
+      fwd[a] = FFTW_R2HC;
+      bwd[a] = FFTW_HC2R;
+      normalization_ *= n;
+    } else {
+      period = 2.0 * n;
+      normalization_ *= 2.0 * n;
+      if (comp == a) {  // face-normal: the N−1 interior faces, DST-I
+        m_[a] = n - 1;
+        lo_[a] = 1;
+        fwd[a] = bwd[a] = FFTW_RODFT00;
+        shift = 1;
+      } else if (comp < 3) {  // cell-centred velocity with ghost 2u_w − u_0: DST-II / DST-III
+        m_[a] = n;
+        fwd[a] = FFTW_RODFT10;
+        bwd[a] = FFTW_RODFT01;
+        shift = 1;
+      } else {  // pressure, homogeneous Neumann: DCT-II / DCT-III
+        m_[a] = n;
+        fwd[a] = FFTW_REDFT10;
+        bwd[a] = FFTW_REDFT01;
+      }
+    }
+    lambda_[a].resize(m_[a]);
+    for (int s = 0; s < m_[a]; ++s) {
+      const double sn = std::sin(std::numbers::pi * (s + shift) / period);
+      lambda_[a][s] = -4.0 / (h * h) * sn * sn;
+    }
+  }
+  const std::size_t total = static_cast<std::size_t>(m_[0]) * m_[1] * m_[2];
+  buf_ = fftw_alloc_real(total);
+  if (buf_ == nullptr) throw std::bad_alloc();
+  // Array3 is x fastest: in FFTW's row-major terms the dimensions are {z, y, x}.
+  const int dims[3] = {m_[2], m_[1], m_[0]};
+  const fftw_r2r_kind kf[3] = {fwd[2], fwd[1], fwd[0]}, kb[3] = {bwd[2], bwd[1], bwd[0]};
+  const unsigned flags = planning == FftPlanning::Measure ? FFTW_MEASURE : FFTW_ESTIMATE;
+  fftw_plan_with_nthreads(omp_get_max_threads());
+  forward_ = fftw_plan_r2r(3, dims, buf_, buf_, kf, flags);
+  backward_ = fftw_plan_r2r(3, dims, buf_, buf_, kb, flags);
+  if (forward_ == nullptr || backward_ == nullptr) throw std::runtime_error("FFTW could not plan a fast solver");
+}
+
+FastSolver::~FastSolver() {
+  fftw_destroy_plan(forward_);
+  fftw_destroy_plan(backward_);
+  fftw_free(buf_);
+}
+
+void FastSolver::solve(Array3& x, double alpha, double beta) {
+  const int mx = m_[0], my = m_[1], mz = m_[2];
+  const int ox = lo_[0], oy = lo_[1], oz = lo_[2];
+  double* b = buf_;
+#pragma omp parallel for collapse(2) schedule(static)
+  for (int k = 0; k < mz; ++k)
+    for (int j = 0; j < my; ++j)
+      for (int i = 0; i < mx; ++i) b[i + mx * (j + my * static_cast<std::size_t>(k))] = x(i + ox, j + oy, k + oz);
+  fftw_execute(forward_);
+  const double* lx = lambda_[0].data();
+  const double* ly = lambda_[1].data();
+  const double* lz = lambda_[2].data();
+  const double norm = normalization_;
+#pragma omp parallel for collapse(2) schedule(static)
+  for (int k = 0; k < mz; ++k)
+    for (int j = 0; j < my; ++j)
+      for (int i = 0; i < mx; ++i) {
+        const double den = (alpha + beta * (lx[i] + ly[j] + lz[k])) * norm;
+        double& v = b[i + mx * (j + my * static_cast<std::size_t>(k))];
+        v = den == 0.0 ? 0.0 : v / den;
+      }
+  fftw_execute(backward_);
+#pragma omp parallel for collapse(2) schedule(static)
+  for (int k = 0; k < mz; ++k)
+    for (int j = 0; j < my; ++j)
+      for (int i = 0; i < mx; ++i) x(i + ox, j + oy, k + oz) = b[i + mx * (j + my * static_cast<std::size_t>(k))];
+}
+
+void FastSolver::transform_round_trip() {
+  fftw_execute(forward_);
+  fftw_execute(backward_);
+}
+
+}  // namespace immerse

@@ -1,0 +1,67 @@
+#pragma once
+// Direct fast-transform solver for (α I + β ∇_h²) x = b on one MAC layout (paper end of §3: the three Helmholtz
+// problems of (9) and the Poisson problem (11) are solved by fast transforms; we use FFTW instead of FISHPACK).
+//
+// The 7-point Laplacian is separable, and on each axis one real transform diagonalizes its 3-point part
+// (numerics-notes.md, "MAC grid and fast transforms"), with N cells of size h on that axis:
+//   periodic axis                              R2HC / HC2R, N points          λ = −(4/h²) sin²(π k/N)
+//   wall axis, face-normal velocity            RODFT00 on the N−1 interior    λ = −(4/h²) sin²(π k/2N), k = 1..N−1
+//   wall axis, cell-centred velocity (ghost)   RODFT10 / RODFT01, N           λ = −(4/h²) sin²(π k/2N), k = 1..N
+//   wall axis, pressure (Neumann)              REDFT10 / REDFT01, N           λ = −(4/h²) sin²(π k/2N), k = 0..N−1
+// In half-complex order slot s holds frequency s or N−s; sin² is the same for both, so λ(s) = −(4/h²) sin²(π s/N).
+// The operator is homogeneous: wall values must already be in b. x = b / (α + β Σλ) in transform space; a zero
+// denominator (the constant null mode of the periodic/Neumann Poisson problem) gives a zero coefficient.
+//
+// One in-place 3D r2r plan pair per solver, created once (see FftPlanning) and executed with FFTW threads
+// (omp_get_max_threads() at construction). Not reentrant: solve() uses an internal buffer.
+// A distributed (FFTW-MPI) backend can replace this class behind the same solve().
+#include <array>
+#include <vector>
+
+#include "immerse/core/Array3.hpp"
+#include "immerse/grid/Grid.hpp"
+
+struct fftw_plan_s;  // FFTW's plan type (fftw_plan is a pointer to it)
+
+namespace immerse {
+
+/// How hard FFTW searches for fast plans: Measure times candidate algorithms (about 1.5x faster transforms at 64³,
+/// planning costs up to seconds, worth it for a long run); Estimate plans instantly (for the many small,
+/// short-lived solvers of tests and verification studies).
+enum class FftPlanning { Estimate, Measure };
+
+/// Which unknowns a solver works on: velocity component 0, 1, 2 (faces), or the cell-centred pressure.
+enum class Layout { VelocityX = 0, VelocityY = 1, VelocityZ = 2, Pressure = 3 };
+
+inline Layout velocity_layout(int d) { return static_cast<Layout>(d); }
+
+class FastSolver {
+ public:
+  FastSolver(const Grid& grid, Layout layout, FftPlanning planning = FftPlanning::Measure);
+  ~FastSolver();
+  FastSolver(const FastSolver&) = delete;
+  FastSolver& operator=(const FastSolver&) = delete;
+
+  /// Overwrites the unknowns of x (shape of the layout: face_shape(d) or cell_shape) with the solution of
+  /// (α I + β ∇_h²) x = b, b being the values of x on entry. Wall faces of a face-normal layout are untouched.
+  void solve(Array3& x, double alpha, double beta);
+
+  /// Runs only the forward and backward transforms on the work buffer (reference cost for benchmarks).
+  void transform_round_trip();
+
+  Layout layout() const { return layout_; }
+  /// Number of unknowns along each axis and the index of the first one in the layout's array.
+  const std::array<int, 3>& count() const { return m_; }
+  const std::array<int, 3>& first() const { return lo_; }
+
+ private:
+  Layout layout_;
+  std::array<int, 3> m_{}, lo_{};
+  std::array<std::vector<double>, 3> lambda_;  // eigenvalues of the 3-point second difference per axis
+  double normalization_ = 1;                    // product over axes of N (DFT) or 2N (others)
+  double* buf_ = nullptr;
+  fftw_plan_s* forward_ = nullptr;
+  fftw_plan_s* backward_ = nullptr;
+};
+
+}  // namespace immerse

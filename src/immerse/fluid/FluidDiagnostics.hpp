@@ -1,0 +1,48 @@
+#pragma once
+// Measurements on MAC fields used by the tests and verification studies: discrete divergence, the
+// homogeneous operators the fast solvers invert and their residuals, and error norms against exact fields.
+#include <functional>
+
+#include "immerse/core/Array3.hpp"
+#include "immerse/core/Vec3.hpp"
+#include "immerse/fluid/FastSolver.hpp"
+#include "immerse/grid/FaceField.hpp"
+#include "immerse/grid/Grid.hpp"
+
+namespace immerse {
+
+/// D^MAC u at every cell (wall faces of u are read as stored).
+void divergence(const Grid& grid, const FaceField& u, Array3& div);
+
+/// Largest |value| of velocity over the unknown faces (all components).
+double max_abs_velocity(const Grid& grid, const FaceField& u);
+
+/// out = (α I + β ∇_h²) x on the unknowns of `layout` with homogeneous walls (the operator FastSolver inverts;
+/// ∇_h² of the pressure is D^MAC G^MAC with Neumann walls). Other entries of out are set to zero.
+void apply_operator(const Grid& grid, Layout layout, const Array3& x, double alpha, double beta, Array3& out);
+
+/// max |(α I + β ∇_h²) x − b| / max |b| over the unknowns of `layout`.
+double relative_residual(const Grid& grid, Layout layout, const Array3& x, const Array3& b, double alpha,
+                         double beta);
+
+struct ErrorNorms {
+  double l2 = 0;   ///< root mean square over the points
+  double max = 0;  ///< largest absolute value
+};
+
+/// Error of u against exact(position) over the unknown faces of all components.
+ErrorNorms velocity_error(const Grid& grid, const FaceField& u, const std::function<Vec3(const Vec3&)>& exact);
+/// Norms of a − b over the unknown faces.
+ErrorNorms velocity_difference(const Grid& grid, const FaceField& a, const FaceField& b);
+/// Error of p against exact(position) over the cells, after removing the mean of each (pressure is defined up
+/// to a constant).
+ErrorNorms pressure_error(const Grid& grid, const Array3& p, const std::function<double(const Vec3&)>& exact);
+/// Norms of (a − mean a) − (b − mean b).
+ErrorNorms pressure_difference(const Array3& a, const Array3& b);
+
+/// u_d(face) = exact(face position)[d] on every face of every component (wall faces included).
+void sample_velocity(const Grid& grid, const std::function<Vec3(const Vec3&)>& exact, FaceField& u);
+/// p(cell) = exact(cell centre).
+void sample_pressure(const Grid& grid, const std::function<double(const Vec3&)>& exact, Array3& p);
+
+}  // namespace immerse

@@ -1,0 +1,27 @@
+#pragma once
+// Physical parameters of the incompressible Navier–Stokes equations (1)–(3), paper §2.1:
+//   rho (u_t + u·∇u) = −∇p + mu Δu + F + f_body,   ∇·u = 0,   u = u_b on the walls.
+// f_body is a uniform body force (a mean pressure gradient) that drives periodic channel/duct flow.
+// On a wall axis a, the wall at the lower end moves with wall_lower[a] and the one at the upper end
+// with wall_upper[a] (constant in time); entries for periodic axes are ignored.
+#include <array>
+
+#include "immerse/core/Vec3.hpp"
+#include "immerse/grid/Grid.hpp"
+
+namespace immerse {
+
+struct FluidParams {
+  double rho = 1.0;
+  double mu = 1.0;
+  Vec3 body_force{};
+  std::array<Vec3, 3> wall_lower{};
+  std::array<Vec3, 3> wall_upper{};
+
+  /// Throws a one-line InputError unless rho, mu > 0 and finite, the body force and wall velocities are finite,
+  /// and on every wall axis the normal wall velocity is the same at both walls (zero net flux through the
+  /// boundary: the pressure Neumann problem (11) is then solvable).
+  void validate(const Grid& grid) const;
+};
+
+}  // namespace immerse

@@ -1,0 +1,17 @@
+#pragma once
+// The committed state of the fluid between two time steps of the projection method (paper eqs. 9–13).
+#include "immerse/core/Array3.hpp"
+#include "immerse/grid/FaceField.hpp"
+
+namespace immerse {
+
+struct FluidState {
+  FaceField u;         ///< velocity u^n on the MAC faces (wall faces hold the normal wall velocity)
+  Array3 p;            ///< pressure p^{n-1/2} at the cell centres (a half step behind u)
+  FaceField adv;       ///< advection term (u·∇_h u)^{n-1} of the previous step, for Adams–Bashforth (10)
+  double dt_prev = 0;  ///< time step that produced u^n (0 before the first step)
+  long step = 0;       ///< number of steps taken
+  double time = 0;     ///< t^n
+};
+
+}  // namespace immerse

@@ -1,0 +1,60 @@
+#pragma once
+// One time step of the pressure-increment projection method on the MAC grid, paper §2.2, eqs. (9)–(13)
+// (Brown, Cortez & Minion 2001). Given u^n, p^{n−1/2}, (u·∇_h u)^{n−1} and the force F^{n+1/2}:
+//
+//   (9)   ρ (u* − u^n)/Δt = −ρ A^{n+1/2} − G p^{n−1/2} + (μ/2) ∇_h²(u* + u^n) + F^{n+1/2} + f_body,  u*|∂Ω = u_b
+//   (10)  A^{n+1/2} = (1 + r/2) (u·∇_h u)^n − (r/2) (u·∇_h u)^{n−1},  r = Δt/Δt_prev
+//         (Adams–Bashforth 2 for a variable step; r = 1 gives the paper's 3/2, −1/2; the first step is
+//         forward Euler, A = (u·∇_h u)^0)
+//   (11)  D G φ = (ρ/Δt) D u*,  n·∇φ = 0 on walls
+//   (12)  u^{n+1} = u* − (Δt/ρ) G φ
+//   (13)  p^{n+1/2} = p^{n−1/2} + φ − (μ/2) D u*
+//
+// Eq. (13) as printed, p^{n−1/2} + φ − (μ/2ρ) D u*, is dimensionally inconsistent (μ D u / ρ is not a pressure);
+// with φ scaled as in (11) the pressure update of Brown–Cortez–Minion (2001) is the one used here.
+// (9) is three Helmholtz problems (I − (μΔt/2ρ) ∇_h²) u*_d = rhs_d and (11) one Poisson problem; all four are
+// solved directly by FastSolver. Since G is applied only at interior faces and ∇_h² for φ is D G with G φ = 0 on
+// walls, D u^{n+1} = 0 to round-off.
+#include <array>
+#include <memory>
+
+#include "immerse/fluid/FastSolver.hpp"
+#include "immerse/fluid/FluidParams.hpp"
+#include "immerse/fluid/FluidState.hpp"
+#include "immerse/fluid/MacGeom.hpp"
+
+namespace immerse {
+
+class NavierStokesSolver {
+ public:
+  /// Validates the parameters against the grid (InputError) and plans the four fast solvers.
+  NavierStokesSolver(const Grid& grid, const FluidParams& params, FftPlanning planning = FftPlanning::Measure);
+
+  const Grid& grid() const { return grid_; }
+  const FluidParams& params() const { return params_; }
+
+  /// A state at rest (u = 0 apart from the normal wall velocity on the wall faces, p = 0), t = 0.
+  FluidState initial_state() const;
+
+  /// Writes into `out` the state one step of size dt after `in` under the force `force` (F^{n+1/2} on the
+  /// velocity faces; its wall faces are ignored). Pure: `in` is only read; `out` must be a different object
+  /// (it is sized on first use, then reused without allocation). Not reentrant: uses internal scratch.
+  void step(const FluidState& in, const FaceField& force, double dt, FluidState& out);
+
+  /// Writes the normal wall velocity into the wall faces of u (the boundary condition (3)).
+  void apply_wall_values(FaceField& u) const;
+
+  /// The fast solver of a layout (three velocity components and the pressure).
+  FastSolver& fast_solver(Layout layout) { return *solvers_[static_cast<int>(layout)]; }
+
+ private:
+  Grid grid_;
+  FluidParams params_;
+  MacGeom geom_;
+  std::array<std::unique_ptr<FastSolver>, 4> solvers_;
+  FaceField ustar_;  // u*, then u^{n+1}
+  Array3 div_;       // D u*
+  Array3 phi_;       // pressure increment φ^{n+1}
+};
+
+}  // namespace immerse
