@@ -2,6 +2,7 @@
 #include <algorithm>
 #include <cmath>
 #include <iostream>
+#include <limits>
 
 #include "immerse/core/Error.hpp"
 #include "immerse/membrane/Geometry.hpp"
@@ -129,7 +130,7 @@ std::vector<Check> stability(bool quick) {
   // Fig. 6: forward Euler at dt = 4 dx is unstable within a few tens of steps.
   const Run euler = run_stability("euler", n, level, 0.01, 4 * h, 10.0);
   checks.push_back({"forward Euler, dt = 4dx, mu = 0.01: step at which instability is detected",
-                    euler.blowup_step < 0 ? INFINITY : euler.blowup_step, "<=", 60});
+                    euler.blowup_step < 0 ? std::numeric_limits<double>::infinity() : double(euler.blowup_step), "<=", 60});
   // Fig. 5: JFNK at dt = 4 dx, mu = 0.1, relaxes to the sphere of radius (abc)^(1/3).
   const Run slow = run_stability("jfnk", n, level, 0.1, 4 * h, 10.0);
   checks.push_back({"JFNK, dt = 4dx, mu = 0.1: steps completed to t = 10", double(slow.steps), ">=",
