@@ -156,6 +156,8 @@ void IBCoupler::spread(std::span<const Vec3> X, std::span<const Vec3> F, FaceFie
 #pragma omp parallel for
     for (long i = 0; i < size; ++i) p[i] = 0.0;
   }
+  // Colours (y block parity, z block parity) one after another; blocks of one colour in
+  // parallel, each adding its nodes in index order: the sums do not depend on the thread count.
   const double inv_h3 = 1.0 / grid_.cell_volume();
   for (int colour = 0; colour < 4; ++colour) {
     const int cy = colour % 2, cz = colour / 2;
