@@ -240,6 +240,19 @@ TEST(IBCoupler, NodesBeyondAWallOrNonFiniteAreNamed) {
   EXPECT_THROW(min_wall_distance(g, X), SimulationError);
   X[3].x = -17.25;  // periodic axis: wraps
   EXPECT_NO_THROW(coupler.spread_force(X, F, f));
+  X[3].x = 1e300;  // still finite: wraps too
+  EXPECT_NO_THROW(coupler.interpolate_velocity(f, X, U));
+}
+
+TEST(IBCoupler, NodesWholePeriodsApartAreTheSameNode) {
+  const Grid g({8, 8, 8}, {1, 1, 1}, {P, P, W});
+  IBCoupler coupler(g);
+  FaceField f1(g), f2(g);
+  const std::vector<Vec3> X1{{0.3125, 0.7, 0.4}}, X2{{0.3125 + 5.0, 0.7 - 3.0, 0.4}}, F{{1, 2, 3}};
+  coupler.spread_force(X1, F, f1);
+  coupler.spread_force(X2, F, f2);
+  for (int d = 0; d < 3; ++d)
+    for (std::size_t p = 0; p < f1[d].size(); ++p) EXPECT_NEAR(f1[d][p], f2[d][p], 1e-12) << d << " " << p;
 }
 
 TEST(NodeDiagnostics, MinWallDistance) {

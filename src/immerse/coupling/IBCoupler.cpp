@@ -11,17 +11,6 @@ namespace immerse {
 
 namespace {
 
-/// Coordinate of x along `axis` in index units of the faces (face = true) or cell centres,
-/// wrapped into [0, n] on periodic axes.
-double index_coordinate(const Grid& g, int axis, double x, bool face) {
-  double xr = x - g.origin()[axis];
-  if (g.periodic(axis)) {
-    const double L = g.length(axis);
-    xr -= L * std::floor(xr / L);
-  }
-  return xr / g.h() - (face ? 0.0 : 0.5);
-}
-
 /// The kernel weights of one node along one grid line: points idx[m] with weights w[m] for
 /// m in [lo, hi). Periodic axes wrap idx; on wall axes points outside the stored array are dropped.
 template <int W>
@@ -31,17 +20,21 @@ struct LineStencil {
   double w[W];
 };
 
+/// t: node coordinate in index units of the points (faces or centres); count: stored points.
 template <class K>
-LineStencil<K::width> line_stencil(const Grid& g, int axis, double x, bool face) {
+LineStencil<K::width> line_stencil(const IndexAxis& axis, double t, int count) {
   LineStencil<K::width> s;
-  const int i0 = K::weights(index_coordinate(g, axis, x, face), s.w);
-  const int n = g.n(axis);
-  if (g.periodic(axis)) {
+  const int i0 = K::weights(t, s.w);
+  if (axis.periodic) {
     s.lo = 0;
     s.hi = K::width;
-    for (int m = 0; m < K::width; ++m) s.idx[m] = ((i0 + m) % n + n) % n;
+    for (int m = 0; m < K::width; ++m) {
+      int i = i0 + m;  // in [-2, n + 3]: wrap without a division
+      while (i < 0) i += axis.n;
+      while (i >= axis.n) i -= axis.n;
+      s.idx[m] = i;
+    }
   } else {
-    const int count = face ? n + 1 : n;
     s.lo = std::max(0, -i0);
     s.hi = std::min(K::width, count - i0);
     for (int m = 0; m < K::width; ++m) s.idx[m] = i0 + m;
@@ -54,9 +47,12 @@ LineStencil<K::width> line_stencil(const Grid& g, int axis, double x, bool face)
 template <class K>
 struct NodeStencil {
   LineStencil<K::width> line[3][2];
-  NodeStencil(const Grid& g, const Vec3& x) {
-    for (int a = 0; a < 3; ++a)
-      for (int face = 0; face < 2; ++face) line[a][face] = line_stencil<K>(g, a, x[a], face == 1);
+  NodeStencil(const std::array<IndexAxis, 3>& axes, const Vec3& x) {
+    for (int a = 0; a < 3; ++a) {
+      const double t = axes[a].face_coordinate(x[a]);
+      line[a][1] = line_stencil<K>(axes[a], t, axes[a].faces());
+      line[a][0] = line_stencil<K>(axes[a], t - 0.5, axes[a].n);
+    }
   }
   const LineStencil<K::width>& along(int axis, int d) const { return line[axis][axis == d ? 1 : 0]; }
 };
@@ -71,7 +67,11 @@ void spread_component(const LineStencil<W>& sx, const LineStencil<W>& sy, const 
     for (int ky = sy.lo; ky < sy.hi; ++ky) {
       const double fyz = fz * sy.w[ky];
       double* row = p + nx * (sy.idx[ky] + ny * sz.idx[kz]);
-      for (int kx = sx.lo; kx < sx.hi; ++kx) row[sx.idx[kx]] += fyz * sx.w[kx];
+      if (sx.lo == 0 && sx.hi == W) {  // the common case, unrolled by the compiler
+        for (int kx = 0; kx < W; ++kx) row[sx.idx[kx]] += fyz * sx.w[kx];
+      } else {
+        for (int kx = sx.lo; kx < sx.hi; ++kx) row[sx.idx[kx]] += fyz * sx.w[kx];
+      }
     }
   }
 }
@@ -87,7 +87,11 @@ double interpolate_component(const LineStencil<W>& sx, const LineStencil<W>& sy,
     for (int ky = sy.lo; ky < sy.hi; ++ky) {
       const double* row = p + nx * (sy.idx[ky] + ny * sz.idx[kz]);
       double sum_x = 0.0;
-      for (int kx = sx.lo; kx < sx.hi; ++kx) sum_x += sx.w[kx] * row[sx.idx[kx]];
+      if (sx.lo == 0 && sx.hi == W) {  // the common case, unrolled by the compiler
+        for (int kx = 0; kx < W; ++kx) sum_x += sx.w[kx] * row[sx.idx[kx]];
+      } else {
+        for (int kx = sx.lo; kx < sx.hi; ++kx) sum_x += sx.w[kx] * row[sx.idx[kx]];
+      }
       sum_y += sy.w[ky] * sum_x;
     }
     sum += sz.w[kz] * sum_y;
@@ -97,7 +101,8 @@ double interpolate_component(const LineStencil<W>& sx, const LineStencil<W>& sy,
 
 }  // namespace
 
-IBCoupler::IBCoupler(const Grid& grid, DeltaKernel kernel) : grid_(grid), kernel_(kernel) {
+IBCoupler::IBCoupler(const Grid& grid, DeltaKernel kernel)
+    : grid_(grid), kernel_(kernel), axes_{IndexAxis(grid, 0), IndexAxis(grid, 1), IndexAxis(grid, 2)} {
   // Blocks one kernel width (or more) wide: a node's writes span at most width + 1 points
   // from its first centre index, so two blocks of the same colour never touch the same point.
   const int width = kernel_width(kernel_);
@@ -127,8 +132,8 @@ void IBCoupler::sort_into_blocks(std::span<const Vec3> X) {
     int block[2];
     for (int b = 0; b < 2; ++b) {
       const int axis = b + 1, na = grid_.n(axis);
-      int lo = std::min(K::first(index_coordinate(grid_, axis, X[l][axis], false)),
-                        K::first(index_coordinate(grid_, axis, X[l][axis], true)));
+      const double t = axes_[axis].face_coordinate(X[l][axis]);
+      int lo = std::min(K::first(t - 0.5), K::first(t));
       lo = grid_.periodic(axis) ? (lo % na + na) % na : std::clamp(lo, 0, na - 1);
       block[b] = std::min(lo / block_size_[b], blocks_[b] - 1);
     }
@@ -151,6 +156,8 @@ void IBCoupler::spread(std::span<const Vec3> X, std::span<const Vec3> F, FaceFie
 #pragma omp parallel for
     for (long i = 0; i < size; ++i) p[i] = 0.0;
   }
+  // Colours (y block parity, z block parity) one after another; blocks of one colour in
+  // parallel, each adding its nodes in index order: the sums do not depend on the thread count.
   const double inv_h3 = 1.0 / grid_.cell_volume();
   for (int colour = 0; colour < 4; ++colour) {
     const int cy = colour % 2, cz = colour / 2;
@@ -160,7 +167,7 @@ void IBCoupler::spread(std::span<const Vec3> X, std::span<const Vec3> F, FaceFie
       const int b = (cy + 2 * (m % my)) + blocks_[0] * (cz + 2 * (m / my));
       for (int p = block_start_[b]; p < block_start_[b + 1]; ++p) {
         const int l = block_nodes_[p];
-        const NodeStencil<K> s(grid_, X[l]);
+        const NodeStencil<K> s(axes_, X[l]);
         for (int d = 0; d < 3; ++d)
           spread_component(s.along(0, d), s.along(1, d), s.along(2, d), F[l][d] * inv_h3, f[d]);
       }
@@ -173,7 +180,7 @@ void IBCoupler::interpolate(const FaceField& u, std::span<const Vec3> X, std::sp
   const long n = static_cast<long>(X.size());
 #pragma omp parallel for
   for (long l = 0; l < n; ++l) {
-    const NodeStencil<K> s(grid_, X[l]);
+    const NodeStencil<K> s(axes_, X[l]);
     for (int d = 0; d < 3; ++d) U[l][d] = interpolate_component(s.along(0, d), s.along(1, d), s.along(2, d), u[d]);
   }
 }

@@ -33,6 +33,7 @@
 
 #include "immerse/core/Vec3.hpp"
 #include "immerse/coupling/DeltaKernel.hpp"
+#include "immerse/coupling/IndexAxis.hpp"
 #include "immerse/grid/FaceField.hpp"
 #include "immerse/grid/Grid.hpp"
 
@@ -63,6 +64,7 @@ class IBCoupler {
 
   Grid grid_;
   DeltaKernel kernel_;
+  std::array<IndexAxis, 3> axes_;  ///< the grid axes in index units
   std::array<int, 2> blocks_{1, 1};      ///< blocks along y and z (each 1 or even)
   std::array<int, 2> block_size_{1, 1};  ///< grid points per block along y and z
   std::vector<int> block_start_;         ///< nodes of block b: block_nodes_[block_start_[b] .. block_start_[b+1])
