@@ -332,7 +332,7 @@ std::vector<Check> bending(bool quick) {
                         observed_order(err[err.size() - 2], err.back()), ">=", quick ? 0.9 : 1.3});
       if (l == 2) {
         checks.push_back({"sphere: load moments / perturbed (eps 0.05), finest, " + rname, sphere.back(), "<=",
-                          quick ? 0.05 : 0.01});
+                          quick ? 1e-3 : 1e-5});
         checks.push_back({"sphere: order of those moments, " + rname, min_observed_order(sphere), ">=", 1.0});
       }
     }
