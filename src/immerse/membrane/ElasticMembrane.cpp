@@ -390,34 +390,32 @@ double ElasticMembrane::compute_energy(const std::vector<Vec3>& X) const {
 
 std::vector<NodeStrain> ElasticMembrane::node_strain(const std::vector<Vec3>& X) const {
   check_size(X);
-  Work w;
-  element_node_pass(X, true, w);
   const int E = static_cast<int>(num_elements());
-  std::vector<Vec3> en_inv(6 * E);  // (A1, A2, 0) per element node
-#pragma omp parallel for schedule(static)
+  std::vector<Vec3> en_inv(6 * E);  // (A1, A2, (lambda1^2 - lambda2^2)/2) per element node
+  int bad = INT_MAX;
+#pragma omp parallel for schedule(static) reduction(min : bad)
   for (int e = 0; e < E; ++e) {
     const Nodes x = element_nodes(elements_[e], X);
+    const Vec3 chord = chord_normal(x);
     for (int k = 0; k < 6; ++k) {
       const Tangents t = membrane_k::tangents(x, kNodeShape[k]);
-      const auto inv = membrane_k::invariants(t, membrane_k::frame(t).J, load_metric(ref_node_, 6 * e + k));
-      en_inv[6 * e + k] = {inv.A1, inv.A2, 0};
+      if (!jacobian_ok(t, chord)) bad = std::min(bad, e);
+      const RefMetric g = load_metric(ref_node_, 6 * e + k);
+      const auto inv = membrane_k::invariants(t, membrane_k::frame(t).J, g);
+      en_inv[6 * e + k] = {inv.A1, inv.A2, membrane_k::principal_half_difference(t, g)};
     }
   }
+  throw_if_bad(bad);
   std::vector<Vec3> inv;
   average(inc_start_, inc_, en_inv, inv);
   std::vector<NodeStrain> out(num_nodes());
   for (std::size_t i = 0; i < out.size(); ++i) {
     const double A1 = inv[i].x, A2 = inv[i].y;
-    // lambda1^2 + lambda2^2 = 2 (A2 + 1), lambda1 lambda2 = e^{A1}
-    const double s = A2 + 1, p = std::exp(A1), r = std::sqrt(std::max(0.0, s * s - p * p));
-    // Principal tensions: eigenvalues of tau restricted to the tangent plane at the node.
-    const Vec3 n = w.node_n[i];
-    const Vec3 axis = std::fabs(n.x) < 0.6 ? Vec3{1, 0, 0} : Vec3{0, 1, 0};
-    const Vec3 e1 = normalized(cross(n, axis)), e2 = cross(n, e1);
-    const Mat3& T = w.node_tau[i];
-    const double t11 = dot(e1, T * e1), t22 = dot(e2, T * e2), t12 = dot(e1, T * e2);
-    const double mean = 0.5 * (t11 + t22), rad = std::hypot(0.5 * (t11 - t22), t12);
-    out[i] = {A1, A2, std::sqrt(s + r), std::sqrt(std::max(0.0, s - r)), mean + rad, mean - rad};
+    // lambda_k^2 = A2 + 1 +- r; (18) in principal axes: tau_k = e^{-A1} (dW/dA1 + dW/dA2 lambda_k^2).
+    const double s = A2 + 1, p = std::exp(A1), r = inv[i].z;
+    const EnergyDensity d = energy_density(law_, A1, A2);
+    out[i] = {A1, A2, std::sqrt(s + r), std::sqrt(std::max(0.0, s - r)), (d.dW_dA1 + d.dW_dA2 * (s + r)) / p,
+              (d.dW_dA1 + d.dW_dA2 * (s - r)) / p};
   }
   return out;
 }

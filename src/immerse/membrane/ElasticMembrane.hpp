@@ -53,7 +53,8 @@ class ElasticMembrane {
   /// Discrete in-plane elastic energy E (J) = sum_e sum_gp W(A1, A2) Jbar w.
   double compute_energy(const std::vector<Vec3>& X) const;
 
-  /// Strain and tension at each node (element-node values averaged over the elements sharing the node).
+  /// Strain and tension at each node: invariants A1, A2 at the element nodes averaged over the elements sharing
+  /// the node, principal stretches from them and principal tensions from (18) in principal axes.
   std::vector<NodeStrain> node_strain(const std::vector<Vec3>& X) const;
   /// Lumped area a_i (m^2) each node carries at X; sum_i a_i = total area. Force density at node i = F_i / a_i
   /// for the contour method.

@@ -86,6 +86,16 @@ inline Invariants invariants(const Tangents& t, double J, const RefMetric& g) {
   return {std::log(J / g.J), A2};
 }
 
+/// Half the difference of the squared principal stretches, (lambda1^2 - lambda2^2)/2, from the eigenvalues of
+/// the 2x2 matrix M = Gbar^{-1} g (g_{alpha beta} = a_alpha . a_beta), computed without the cancellation of
+/// sqrt((tr M / 2)^2 - det M) near isotropic states. With (20): lambda1,2^2 = A2 + 1 +- this.
+inline double principal_half_difference(const Tangents& t, const RefMetric& g) {
+  const double g11 = dot(t.a_xi, t.a_xi), g12 = dot(t.a_xi, t.a_eta), g22 = dot(t.a_eta, t.a_eta);
+  const double m11 = g.g_xx * g11 + g.g_xe * g12, m12 = g.g_xx * g12 + g.g_xe * g22;
+  const double m21 = g.g_xe * g11 + g.g_ee * g12, m22 = g.g_xe * g12 + g.g_ee * g22;
+  return std::sqrt(std::fmax(0.0, 0.25 * (m11 - m22) * (m11 - m22) + m12 * m21));
+}
+
 /// Tension tensor (18).
 inline Mat3 tension(const EnergyDensity& w, double A1, const Mat3& B, const Vec3& n) {
   return std::exp(-A1) * (w.dW_dA1 * (Mat3::identity() - Mat3::outer(n, n)) + w.dW_dA2 * B);
