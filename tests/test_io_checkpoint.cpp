@@ -1,4 +1,5 @@
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <cmath>
 #include <filesystem>
@@ -19,6 +20,15 @@ namespace {
 // shutdown then prints "HDF5: infinite loop closing library". The sweep below provokes exactly that, so this
 // test program skips HDF5's atexit shutdown (the process is ending anyway). Must run before any HDF5 call.
 const bool kNoHdf5Atexit = H5dont_atexit() >= 0;
+
+// Removes this program's scratch directory at the end.
+class ScratchCleanup : public ::testing::Environment {
+ public:
+  void TearDown() override {
+    fs::remove_all(fs::temp_directory_path() / ("immerse_test_checkpoint_" + std::to_string(::getpid())));
+  }
+};
+const auto* const kCleanup = ::testing::AddGlobalTestEnvironment(new ScratchCleanup);
 
 fs::path scratch(const std::string& name) {
   const fs::path dir = fs::temp_directory_path() / ("immerse_test_checkpoint_" + std::to_string(::getpid()));
