@@ -1,0 +1,59 @@
+#pragma once
+// A fully resolved configuration: every key its schema declares is present (defaults filled in), each value
+// already validated. Built by ConfigSchema::parse_file / parse_string / defaults.
+#include <cstdint>
+#include <filesystem>
+#include <map>
+#include <memory>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "immerse/io/ConfigSchema.hpp"
+
+namespace immerse::io {
+
+class Config {
+ public:
+  /// Typed value of a declared key: "fluid.mu", or "membrane[1].law.Es" inside a repeated table.
+  /// T is the declared type: double, std::int64_t (or int), bool, std::string, std::vector<double>, Vec3.
+  /// An undeclared key or another type is a programming error (std::logic_error).
+  template <class T>
+  T get(std::string_view key) const;
+
+  /// Number of entries of the repeated table `name` ([[name]]).
+  std::size_t count(std::string_view name) const;
+  /// Entry i of the repeated table `name`, itself a Config of the entry schema.
+  const Config& entry(std::string_view name, std::size_t i) const;
+
+  /// The resolved configuration as TOML, each key preceded by its doc string, allowed values and default.
+  /// Parsing it with the same schema gives back an equal Config.
+  std::string to_toml_string() const;
+  /// Writes to_toml_string() to `path` atomically (e.g. DIR/config.resolved.toml).
+  void save(const std::filesystem::path& path) const;
+
+  const ConfigSchema& schema() const { return *schema_; }
+  bool operator==(const Config& other) const;
+
+ private:
+  friend class ConfigSchema;
+  friend class ConfigResolver;
+  explicit Config(std::shared_ptr<const ConfigSchema> schema);
+  const ConfigValue& value(std::string_view key) const;
+  ConfigValue& value_ref(const std::string& key);
+  void write_toml(std::string& out, const std::string& section) const;
+
+  std::shared_ptr<const ConfigSchema> schema_;
+  std::map<std::string, ConfigValue, std::less<>> values_;
+  std::map<std::string, std::vector<Config>, std::less<>> tables_;
+};
+
+template <> double Config::get<double>(std::string_view key) const;
+template <> std::int64_t Config::get<std::int64_t>(std::string_view key) const;
+template <> int Config::get<int>(std::string_view key) const;
+template <> bool Config::get<bool>(std::string_view key) const;
+template <> std::string Config::get<std::string>(std::string_view key) const;
+template <> std::vector<double> Config::get<std::vector<double>>(std::string_view key) const;
+template <> Vec3 Config::get<Vec3>(std::string_view key) const;
+
+}  // namespace immerse::io

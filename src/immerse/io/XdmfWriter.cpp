@@ -1,0 +1,198 @@
+#include "immerse/io/XdmfWriter.hpp"
+
+#include <cerrno>
+#include <cstdio>
+#include <cstring>
+#include <stdexcept>
+
+#include "immerse/core/Error.hpp"
+#include "immerse/io/AtomicFile.hpp"
+#include "immerse/io/CellFields.hpp"
+#include "immerse/io/Hdf5.hpp"
+#include "immerse/io/TomlFormat.hpp"
+
+namespace immerse::io {
+
+namespace {
+
+void check_name(const std::string& what, const std::string& name) {
+  bool ok = !name.empty();
+  for (const char c : name) ok = ok && (std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '-' || c == '.');
+  if (!ok) throw std::logic_error("XdmfWriter: bad " + what + " name '" + name + "'");
+}
+
+std::string dims_text(const std::vector<hsize_t>& dims) {
+  std::string s;
+  for (const auto d : dims) s.append(s.empty() ? "" : " ").append(std::to_string(d));
+  return s;
+}
+
+std::string data_item(const std::string& file, const std::string& dataset, const std::vector<hsize_t>& dims,
+                      bool integer) {
+  return "<DataItem Dimensions=\"" + dims_text(dims) + "\" NumberType=\"" + (integer ? "Int" : "Float") +
+         "\" Precision=\"" + (integer ? "4" : "8") + "\" Format=\"HDF\">" + file + ":" + dataset + "</DataItem>";
+}
+
+std::string attribute(const std::string& name, bool vector, const std::string& item) {
+  return "        <Attribute Name=\"" + name + "\" AttributeType=\"" + (vector ? "Vector" : "Scalar") +
+         "\" Center=\"Node\">\n          " + item + "\n        </Attribute>\n";
+}
+
+std::vector<double> flatten(std::span<const Vec3> v) {
+  std::vector<double> out;
+  out.reserve(3 * v.size());
+  for (const auto& p : v) out.insert(out.end(), {p.x, p.y, p.z});
+  return out;
+}
+
+const char* kMembraneAttr = "xdmf_membranes";
+const char* kFluidAttr = "xdmf_fluid";
+
+}  // namespace
+
+std::string XdmfWriter::frame_file_name(int frame) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "fields_%06d.h5", frame);
+  return buf;
+}
+
+XdmfWriter::XdmfWriter(std::filesystem::path dir, int first_frame) : dir_(std::move(dir)) {
+  std::error_code ec;
+  std::filesystem::create_directories(dir_, ec);
+  if (ec) throw InputError("cannot write " + dir_.string() + ": " + ec.message());
+  hdf5::Quiet quiet;
+  for (int f = 0; f < first_frame; ++f) {
+    const std::filesystem::path p = dir_ / frame_file_name(f);
+    hdf5::Handle file = H5Fis_hdf5(p.c_str()) > 0 ? hdf5::open_file_readonly(p) : hdf5::Handle{};
+    std::string m, fl;
+    if (!file.valid() || !hdf5::read_attribute(file.get(), kMembraneAttr, m) ||
+        !hdf5::read_attribute(file.get(), kFluidAttr, fl))
+      throw InputError("cannot continue the output series: " + p.string() +
+                       " is missing, truncated or not written by immerse");
+    membrane_xml_.push_back(std::move(m));
+    fluid_xml_.push_back(std::move(fl));
+  }
+}
+
+std::filesystem::path XdmfWriter::write_frame(double time, std::span<const SurfaceFrame> membranes,
+                                              const FluidFrame* fluid) {
+  const int frame = frames();
+  const std::string fname = frame_file_name(frame);
+  const std::filesystem::path path = dir_ / fname;
+  const std::string t = format_number(time);
+  char tag[16];
+  std::snprintf(tag, sizeof tag, "%06d", frame);
+
+  AtomicFile out(path);
+  hdf5::Quiet quiet;
+  errno = 0;
+  hdf5::Handle file = hdf5::create_file(out.temp_path());
+  if (!file.valid()) out.fail(errno ? errno : EIO);
+  const auto check = [&](bool ok, const std::string& what) {
+    if (!ok) out.fail("HDF5 error writing " + what);
+  };
+  check(hdf5::write_attribute(file.get(), "time", time), "time");
+
+  // Membranes: one spatial collection per frame.
+  std::string mx = "    <Grid Name=\"membranes_" + std::string(tag) +
+                   "\" GridType=\"Collection\" CollectionType=\"Spatial\">\n      <Time Value=\"" + t + "\"/>\n";
+  hdf5::Handle mgroup = hdf5::create_group(file.get(), "membranes");
+  check(mgroup.valid(), "/membranes");
+  for (const auto& m : membranes) {
+    check_name("membrane", m.name);
+    const std::string base = "/membranes/" + m.name;
+    const hsize_t nn = m.nodes.size(), nt = m.triangles.size();
+    hdf5::Handle g = hdf5::create_group(mgroup.get(), m.name);
+    check(g.valid(), base);
+    std::vector<std::int32_t> conn;
+    conn.reserve(6 * nt);
+    for (const auto& tri : m.triangles)
+      for (const int v : tri) {
+        if (v < 0 || static_cast<hsize_t>(v) >= nn)
+          throw std::logic_error("XdmfWriter: membrane " + m.name + " has a triangle node outside its nodes");
+        conn.push_back(v);
+      }
+    check(hdf5::write_doubles(g.get(), "nodes", flatten(m.nodes).data(), {nn, 3}), base + "/nodes");
+    check(hdf5::write_int32(g.get(), "connectivity", conn.data(), {nt, 6}), base + "/connectivity");
+    mx += "      <Grid Name=\"" + m.name + "\" GridType=\"Uniform\">\n"
+          "        <Topology TopologyType=\"Triangle_6\" NumberOfElements=\"" + std::to_string(nt) + "\">\n"
+          "          " + data_item(fname, base + "/connectivity", {nt, 6}, true) + "\n        </Topology>\n"
+          "        <Geometry GeometryType=\"XYZ\">\n          " + data_item(fname, base + "/nodes", {nn, 3}, false) +
+          "\n        </Geometry>\n";
+    for (const auto& [name, v] : m.vectors) {
+      check_name("field", name);
+      if (v.size() != nn) throw std::logic_error("XdmfWriter: field " + name + " of " + m.name + " has wrong size");
+      check(hdf5::write_doubles(g.get(), name, flatten(v).data(), {nn, 3}), base + "/" + name);
+      mx += attribute(name, true, data_item(fname, base + "/" + name, {nn, 3}, false));
+    }
+    for (const auto& [name, v] : m.scalars) {
+      check_name("field", name);
+      if (v.size() != nn) throw std::logic_error("XdmfWriter: field " + name + " of " + m.name + " has wrong size");
+      check(hdf5::write_doubles(g.get(), name, v.data(), {nn}), base + "/" + name);
+      mx += attribute(name, false, data_item(fname, base + "/" + name, {nn}, false));
+    }
+    mx += "      </Grid>\n";
+  }
+  mx += "    </Grid>\n";
+  check(mgroup.close(), "/membranes");
+
+  // Fluid: cell-centred fields on a 3DCoRectMesh (XDMF orders dimensions, origin and spacing z, y, x).
+  std::string fx;
+  if (fluid) {
+    const Grid& g = fluid->grid;
+    const auto& n = g.n();
+    if (fluid->pressure.shape() != n) throw std::logic_error("XdmfWriter: pressure is not cell-centred on the grid");
+    for (int d = 0; d < 3; ++d)
+      if (fluid->velocity[d].shape() != g.face_shape(d))
+        throw std::logic_error("XdmfWriter: velocity does not match the grid's face layout");
+    const CellFields cells = CellFields::from_faces(g, fluid->velocity);
+    const std::vector<hsize_t> sdims{hsize_t(n[2]), hsize_t(n[1]), hsize_t(n[0])};
+    const std::vector<hsize_t> vdims{hsize_t(n[2]), hsize_t(n[1]), hsize_t(n[0]), 3};
+    std::vector<double> vel(3 * cells.velocity[0].size());
+    for (std::size_t c = 0; c < cells.velocity[0].size(); ++c)
+      for (int d = 0; d < 3; ++d) vel[3 * c + d] = cells.velocity[d][c];
+    hdf5::Handle fg = hdf5::create_group(file.get(), "fluid");
+    check(fg.valid() && hdf5::write_doubles(fg.get(), "velocity", vel.data(), vdims) &&
+              hdf5::write_doubles(fg.get(), "pressure", fluid->pressure.data(), sdims) &&
+              hdf5::write_doubles(fg.get(), "vorticity_magnitude", cells.vorticity_magnitude.data(), sdims) &&
+              fg.close(),
+          "/fluid");
+    const double h = g.h();
+    const Vec3 c0 = g.cell_position(0, 0, 0);
+    fx = "    <Grid Name=\"fluid_" + std::string(tag) + "\" GridType=\"Uniform\">\n      <Time Value=\"" + t +
+         "\"/>\n      <Topology TopologyType=\"3DCoRectMesh\" Dimensions=\"" + dims_text(sdims) +
+         "\"/>\n      <Geometry GeometryType=\"ORIGIN_DXDYDZ\">\n"
+         "        <DataItem Dimensions=\"3\" NumberType=\"Float\" Precision=\"8\" Format=\"XML\">" +
+         format_number(c0.z) + " " + format_number(c0.y) + " " + format_number(c0.x) +
+         "</DataItem>\n        <DataItem Dimensions=\"3\" NumberType=\"Float\" Precision=\"8\" Format=\"XML\">" +
+         format_number(h) + " " + format_number(h) + " " + format_number(h) + "</DataItem>\n      </Geometry>\n" +
+         attribute("velocity", true, data_item(fname, "/fluid/velocity", vdims, false)) +
+         attribute("pressure", false, data_item(fname, "/fluid/pressure", sdims, false)) +
+         attribute("vorticity_magnitude", false, data_item(fname, "/fluid/vorticity_magnitude", sdims, false)) +
+         "    </Grid>\n";
+  }
+  check(hdf5::write_attribute(file.get(), kMembraneAttr, mx) && hdf5::write_attribute(file.get(), kFluidAttr, fx),
+        "XDMF fragments");
+  errno = 0;
+  if (!file.close()) out.fail(errno ? std::string(std::strerror(errno)) : "HDF5 error closing the file");
+  out.commit();
+
+  membrane_xml_.push_back(std::move(mx));
+  fluid_xml_.push_back(std::move(fx));
+  write_series();
+  return path;
+}
+
+void XdmfWriter::write_series() const {
+  const auto series = [&](const std::string& name, const std::vector<std::string>& fragments) {
+    std::string x = "<?xml version=\"1.0\" ?>\n<!DOCTYPE Xdmf SYSTEM \"Xdmf.dtd\" []>\n<Xdmf Version=\"3.0\">\n"
+                    "  <Domain>\n    <Grid Name=\"" + name + "\" GridType=\"Collection\" CollectionType=\"Temporal\">\n";
+    for (const auto& f : fragments) x += f;
+    x += "    </Grid>\n  </Domain>\n</Xdmf>\n";
+    AtomicFile::write(dir_ / (name + ".xdmf"), x);
+  };
+  series("membranes", membrane_xml_);
+  series("fluid", fluid_xml_);
+}
+
+}  // namespace immerse::io

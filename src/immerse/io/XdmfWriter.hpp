@@ -1,0 +1,66 @@
+#pragma once
+// ParaView output: one HDF5 file per output frame (DIR/fields_000012.h5) and two XDMF 3 files describing the
+// whole time series (temporal collections), rewritten atomically after every frame:
+//   DIR/membranes.xdmf  every membrane as a surface of 6-node quadratic triangles (TopologyType "Triangle_6",
+//                       node order: vertices 0, 1, 2, then mid-sides 0-1, 1-2, 2-0, as VTK_QUADRATIC_TRIANGLE)
+//                       with node fields (vectors such as force and velocity, scalars such as tension invariants);
+//   DIR/fluid.xdmf      the fluid on the cell centres of the MAC grid (3DCoRectMesh): cell-centred velocity,
+//                       pressure and vorticity magnitude (CellFields).
+// HDF5 layout of a frame: attribute "time"; /membranes/<name>/{nodes [N,3], connectivity [T,6] int32,
+// <field> [N,3] or [N]}; /fluid/{velocity [nz,ny,nx,3], pressure [nz,ny,nx], vorticity_magnitude [nz,ny,nx]}.
+// Each frame file also stores its own XDMF fragments (attributes), so a restarted run can rebuild the series.
+#include <array>
+#include <filesystem>
+#include <span>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "immerse/core/Array3.hpp"
+#include "immerse/core/Vec3.hpp"
+#include "immerse/grid/FaceField.hpp"
+#include "immerse/grid/Grid.hpp"
+
+namespace immerse::io {
+
+/// One membrane surface at one output time. Names are [A-Za-z0-9_.-]; every field has one value per node.
+struct SurfaceFrame {
+  std::string name;
+  std::span<const Vec3> nodes;
+  std::span<const std::array<int, 6>> triangles;
+  std::vector<std::pair<std::string, std::span<const Vec3>>> vectors;
+  std::vector<std::pair<std::string, std::span<const double>>> scalars;
+};
+
+/// The fluid at one output time: face velocities and cell-centred pressure on `grid`.
+struct FluidFrame {
+  const Grid& grid;
+  const FaceField& velocity;
+  const Array3& pressure;
+};
+
+class XdmfWriter {
+ public:
+  /// Writes into `dir` (created if missing). `first_frame` > 0 continues a restarted run: frames
+  /// 0..first_frame-1 already exist in `dir` and are read back into the series (InputError if one is missing
+  /// or damaged); later frames are overwritten.
+  explicit XdmfWriter(std::filesystem::path dir, int first_frame = 0);
+
+  /// Writes frame number frames() at `time` and updates both XDMF files. Returns the HDF5 file written.
+  /// Throws InputError "cannot write <path>: ..." on I/O failure, std::logic_error on inconsistent sizes.
+  std::filesystem::path write_frame(double time, std::span<const SurfaceFrame> membranes,
+                                    const FluidFrame* fluid = nullptr);
+
+  int frames() const { return static_cast<int>(membrane_xml_.size()); }
+  const std::filesystem::path& dir() const { return dir_; }
+  static std::string frame_file_name(int frame);
+
+ private:
+  void write_series() const;
+
+  std::filesystem::path dir_;
+  std::vector<std::string> membrane_xml_;  // per frame: a <Grid> fragment of membranes.xdmf
+  std::vector<std::string> fluid_xml_;     // per frame: a <Grid> fragment of fluid.xdmf, or "" without fluid
+};
+
+}  // namespace immerse::io
