@@ -1,0 +1,112 @@
+#include "immerse/simulation/RunSchema.hpp"
+
+#include "immerse/timestep/MembraneIntegrator.hpp"
+
+namespace immerse {
+
+using io::ConfigSchema;
+using io::Range;
+
+namespace {
+
+ConfigSchema membrane_schema() {
+  ConfigSchema m;
+  m.add_string("shape", "sphere", {"sphere", "ellipsoid", "oblate", "rbc"},
+               "initial shape: sphere (radius), ellipsoid (semi_axes, eq. 43), oblate spheroid (radius of the "
+               "equal-volume sphere, aspect_ratio, inclination; §4.2.2) or biconcave red blood cell (eq. 45, R0)");
+  m.add_double("radius", 1e-6, Range::positive(), "sphere radius / radius of the equal-volume sphere (m)");
+  m.add_vec3("semi_axes", {1e-6, 1e-6, 1e-6}, Range::positive(), "ellipsoid semi-axes along x, y, z (m)");
+  m.add_double("aspect_ratio", 1.0, Range::open_closed(0, 1), "oblate spheroid: short over long axis b/a");
+  m.add_double("inclination", 0.0, Range::closed(-3.2, 3.2), "oblate spheroid: angle of the long axis from x towards z (rad)");
+  m.add_double("R0", 3.91e-6, Range::positive(), "red blood cell radius R0 of eq. (45) (m)");
+  m.add_string("reference", "initial", {"initial", "sphere"},
+               "stress-free reference configuration: the initial shape, or a sphere of reference_radius (§4.1)");
+  m.add_double("reference_radius", 1e-6, Range::positive(), "radius of the reference sphere when reference = \"sphere\" (m)");
+  m.add_vec3("center", {0, 0, 0}, Range::any(), "position of the shape's centre (m)");
+  m.add_vec3("rotation_axis", {0, 0, 1}, Range::any(), "axis of the rigid rotation applied to the shape");
+  m.add_double("rotation_angle", 0.0, Range::closed(-7, 7), "angle of the rigid rotation (rad)");
+  m.add_string("mesh.family", "icosahedral", {"icosahedral", "octahedral", "file"},
+               "subdivided icosahedron (10*4^(l+1)+2 nodes) or octahedron (4*4^(l+1)+2 nodes) mapped onto the shape, "
+               "or a Gmsh file (mesh.file, 6- or 3-node triangles, used as is)");
+  m.add_int("mesh.level", 3, Range::closed(0, 7), "subdivision level (icosahedral 4: 10,242 nodes; octahedral 5: 16,386)");
+  m.add_string("mesh.file", "", {}, "Gmsh .msh file when mesh.family = \"file\"");
+  m.add_string("law", "neo_hookean", {"neo_hookean", "yeoh", "skalak"}, "strain energy: eq. (22), (23) or (24)");
+  m.add_double("Es", 1e-6, Range::positive(), "neo-Hookean surface elastic modulus E_s of eq. (22) (N/m)");
+  m.add_double("C10", 2.5e-6, Range::positive(), "Yeoh C10 of eq. (23) (N/m)");
+  m.add_double("C30", 1.7e-7, Range::positive(), "Yeoh C30 of eq. (23) (N/m)");
+  m.add_double("C11", 5e-6, Range::positive(), "Skalak C11 of eq. (24) (N/m)");
+  m.add_double("C21", 5e-4, Range::positive(), "Skalak C21 of eq. (24) (N/m)");
+  m.add_double("kappa_B", 0.0, Range::non_negative(), "bending modulus of eq. (25) (J); 0 switches bending off");
+  m.add_string("bending_reference", "zero", {"zero", "rest"},
+               "reference mean curvature of eq. (25): zero (flat rest state, §4.2.3) or that of the reference shape");
+  m.add_string("force", "contour", {"contour", "energy"},
+               "nodal forces by the contour integral of eq. (42), or energy-consistent -dE/dX");
+  return m;
+}
+
+}  // namespace
+
+ConfigSchema run_schema() {
+  ConfigSchema s;
+  s.add_string("scenario.kind", "none",
+               {"none", "oscillating_membrane", "capsule_shear", "oblate_shear", "bending_shear"},
+               "experiment whose nondimensional groups below set the dimensional values (see scenarios/README.md)");
+  s.add_double("scenario.G", 0.05, Range::positive(), "capillary number G = mu k a / E_s of eq. (44) (shear scenarios)");
+  s.add_double("scenario.Re", 1e-3, Range::positive(), "Reynolds number Re = rho k a^2 / mu (shear scenarios)");
+  s.add_double("scenario.kappa_B_hat", 0.0, Range::non_negative(), "reduced bending modulus kappa_B / (a^2 E_s) (§4.2.3)");
+  s.add_double("scenario.aspect_ratio", 1.0, Range::open_closed(0, 1), "oblate_shear: initial aspect ratio b/a (§4.2.2)");
+  s.add_double("scenario.theta0", 0.0, Range::closed(-3.2, 3.2), "oblate_shear: initial inclination (rad)");
+  s.add_double("scenario.k_dt", 0.01, Range::positive(), "shear scenarios: time step in units of 1/k");
+  s.add_double("scenario.kt_end", 10.0, Range::positive(), "shear scenarios: end time in units of 1/k");
+
+  s.add_double("domain.Lx", 1e-5, Range::positive(), "box length along x (m)");
+  s.add_double("domain.Ly", 1e-5, Range::positive(), "box length along y (m)");
+  s.add_double("domain.Lz", 1e-5, Range::positive(), "box length along z (m)");
+  s.add_vec3("domain.origin", {0, 0, 0}, Range::any(), "lower corner of the box (m)");
+  s.add_int("grid.nx", 32, Range::at_least(2), "cells along x (cells are cubic: Lx/nx = Ly/ny = Lz/nz)");
+  s.add_int("grid.ny", 32, Range::at_least(2), "cells along y");
+  s.add_int("grid.nz", 32, Range::at_least(2), "cells along z");
+  for (const char* a : {"x", "y", "z"}) {
+    const std::string axis = a;
+    s.add_string("boundary." + axis, "periodic", {"periodic", "wall"}, "boundary along " + axis + ": periodic or two no-slip walls");
+    s.add_vec3("boundary." + axis + "_lower_velocity", {0, 0, 0}, Range::any(),
+               "velocity of the wall at the lower end of " + axis + " (m/s)");
+    s.add_vec3("boundary." + axis + "_upper_velocity", {0, 0, 0}, Range::any(),
+               "velocity of the wall at the upper end of " + axis + " (m/s)");
+  }
+  s.add_double("fluid.rho", 1000.0, Range::positive(), "density (kg/m^3)");
+  s.add_double("fluid.mu", 1e-3, Range::positive(), "dynamic viscosity (Pa s)");
+  s.add_vec3("fluid.body_force", {0, 0, 0}, Range::any(), "uniform body force, a mean pressure gradient (N/m^3)");
+  s.add_string("fluid.initial", "rest", {"rest", "couette"},
+               "initial velocity: at rest, or the linear (Couette) profile between the moving walls");
+
+  s.add_string("coupling.kernel", "roma3", {"roma3", "peskin4"},
+               "discrete delta: Roma-Peskin-Berger 3-point of eq. (8), or Peskin's 4-point");
+
+  s.add_string("time.scheme", "jfnk", integrator_names(),
+               "membrane update: jfnk (§2.4.3), lbfgs, bfgs (eq. 35, small meshes), euler (eq. 28), rk2");
+  s.add_double("time.dt", 1e-4, Range::positive(), "time step (s)");
+  s.add_double("time.end", 1e-2, Range::positive(), "end time (s)");
+  s.add_double("time.theta", 0.5, Range::closed(0.5, 1.0),
+               "theta-method weight of the implicit update: 0.5 trapezoidal (eq. 29), 1 backward Euler (L-stable)");
+  s.add_double("time.dt_min", 1e-12, Range::positive(), "floor of the step-halving on a failed nonlinear solve (s)");
+  s.add_double("time.max_speed", 1e3, Range::positive(),
+               "runaway bound: a node velocity above it stops the run as unstable (m/s)");
+
+  s.add_double("solver.newton_rtol", 1e-8, Range::open(0, 1), "Newton stop ||g|| / ||X|| (§4: 1e-8)");
+  s.add_double("solver.gmres_rtol", 1e-3, Range::open(0, 1), "relative tolerance of each GMRES solve (§4: 1e-3)");
+  s.add_int("solver.max_newton_its", 20, Range::at_least(1), "nonlinear iterations before a step is rejected and halved");
+  s.add_int("solver.bfgs_memory", 20, Range::at_least(1), "stored pairs of the limited-memory quasi-Newton");
+  s.add_string("solver.petsc_options", "", {}, "extra PETSc options, e.g. \"-ksp_gmres_restart 50\"");
+
+  s.add_int("output.diagnostics_every", 1, Range::at_least(1), "steps between rows of diagnostics.csv");
+  s.add_int("output.fields_every", 0, Range::at_least(0), "steps between ParaView frames (XDMF + HDF5); 0: none");
+  s.add_bool("output.fluid_fields", true, "include the fluid (velocity, pressure, vorticity) in the ParaView frames");
+  s.add_int("output.checkpoint_every", 0, Range::at_least(0), "steps between checkpoints; 0: only at the end");
+  s.add_double("output.log_seconds", 10.0, Range::positive(), "wall-clock seconds between log lines when not on a terminal");
+
+  s.add_table_array("membrane", membrane_schema(), 0, "the membranes (capsules, cells), one [[membrane]] table each");
+  return s;
+}
+
+}  // namespace immerse

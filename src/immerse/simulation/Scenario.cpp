@@ -1,0 +1,60 @@
+#include "immerse/simulation/Scenario.hpp"
+
+#include <cstdio>
+#include <string>
+#include <vector>
+
+#include "immerse/core/Error.hpp"
+
+namespace immerse {
+
+namespace {
+std::string num(double v) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "%.17g", v);
+  return buf;
+}
+bool is_shear(const std::string& kind) {
+  return kind == "capsule_shear" || kind == "oblate_shear" || kind == "bending_shear";
+}
+}  // namespace
+
+double shear_rate(const io::Config& c) {
+  if (!is_shear(c.get<std::string>("scenario.kind"))) return 0.0;
+  const double a = c.get<double>("membrane[0].radius");
+  return c.get<double>("scenario.Re") * c.get<double>("fluid.mu") / (c.get<double>("fluid.rho") * a * a);
+}
+
+io::Config apply_scenario(const io::Config& config) {
+  const std::string kind = config.get<std::string>("scenario.kind");
+  if (!is_shear(kind)) return config;
+  if (config.count("membrane") != 1) throw InputError("scenario.kind = \"" + kind + "\": needs exactly one [[membrane]]");
+  require(config.get<std::string>("boundary.z") == "wall", "boundary.z", "\"wall\" for scenario.kind = \"" + kind + "\"");
+  const double a = config.get<double>("membrane[0].radius"), mu = config.get<double>("fluid.mu");
+  const double k = shear_rate(config), Es = mu * k * a / config.get<double>("scenario.G");
+  const double Lz = config.get<double>("domain.Lz");
+  const Vec3 o = config.get<Vec3>("domain.origin");
+  const Vec3 centre = {o.x + 0.5 * config.get<double>("domain.Lx"), o.y + 0.5 * config.get<double>("domain.Ly"),
+                       o.z + 0.5 * Lz};
+  std::vector<std::string> set = {
+      "membrane[0].law=\"neo_hookean\"",
+      "membrane[0].Es=" + num(Es),
+      "membrane[0].kappa_B=" + num(config.get<double>("scenario.kappa_B_hat") * a * a * Es),
+      "membrane[0].center=[" + num(centre.x) + "," + num(centre.y) + "," + num(centre.z) + "]",
+      "boundary.z_lower_velocity=[" + num(-0.5 * k * Lz) + ",0,0]",
+      "boundary.z_upper_velocity=[" + num(0.5 * k * Lz) + ",0,0]",
+      "fluid.initial=\"couette\"",
+      "time.dt=" + num(config.get<double>("scenario.k_dt") / k),
+      "time.end=" + num(config.get<double>("scenario.kt_end") / k),
+  };
+  if (kind == "oblate_shear") {
+    set.push_back("membrane[0].shape=\"oblate\"");
+    set.push_back("membrane[0].aspect_ratio=" + num(config.get<double>("scenario.aspect_ratio")));
+    set.push_back("membrane[0].inclination=" + num(config.get<double>("scenario.theta0")));
+  }
+  io::Config derived = config;
+  config.schema().apply_overrides(derived, set);
+  return derived;
+}
+
+}  // namespace immerse

@@ -1,0 +1,20 @@
+#pragma once
+// Scenario kinds turn nondimensional groups into the dimensional values of a run (SI units throughout).
+//
+// Shear scenarios (capsule_shear §4.2.1, oblate_shear §4.2.2, bending_shear §4.2.3): a capsule of radius a
+// (membrane[0].radius; for an oblate spheroid the radius of the equal-volume sphere) at the box centre, walls at
+// z = z_c -+ Lz/2 moving with -+ k Lz/2 along x, so that the undisturbed flow is u = (k (z - z_c), 0, 0). From
+//   Re = rho k a^2 / mu,   G = mu k a / E_s  (44),   kappa_B_hat = kappa_B / (a^2 E_s)
+// follow k = Re mu / (rho a^2), E_s = mu k a / G and kappa_B = kappa_B_hat a^2 E_s. The fluid starts in the
+// undisturbed shear flow; time.dt and time.end are read in units of the shear time 1/k (k dt and k t_end).
+#include "immerse/io/Config.hpp"
+
+namespace immerse {
+
+/// The configuration with the scenario's derived values written into their keys (for printing and saving).
+io::Config apply_scenario(const io::Config& config);
+
+/// The shear rate k of a shear scenario (0 for other kinds).
+double shear_rate(const io::Config& config);
+
+}  // namespace immerse

@@ -1,0 +1,20 @@
+#pragma once
+// The Taylor shape parameter of §4.2.1: D_xz = (L - B)/(L + B), with L and B the maximum and minimum radial
+// distances from the centroid of the membrane's section by the plane of shear (the x-z plane through the
+// centroid); theta is the inclination of the long axis (the direction of L) to the flow direction x, in
+// (-pi/2, pi/2]. The section is the polygon where the plane cuts the four flat sub-triangles of each curved element.
+#include <vector>
+
+#include "immerse/membrane/Mesh.hpp"
+
+namespace immerse {
+
+struct ShearPlaneProfile {
+  double L = 0, B = 0;
+  double D_xz = 0;
+  double theta = 0;
+};
+
+ShearPlaneProfile shear_plane_profile(const Mesh& mesh, const std::vector<Vec3>& X, const Vec3& centroid);
+
+}  // namespace immerse

@@ -1,0 +1,323 @@
+#include "immerse/simulation/Simulation.hpp"
+
+#include <chrono>
+#include <cmath>
+#include <sstream>
+
+#include "immerse/core/Error.hpp"
+#include "immerse/coupling/NodeDiagnostics.hpp"
+#include "immerse/membrane/GmshReader.hpp"
+#include "immerse/membrane/MeshGenerator.hpp"
+#include "immerse/membrane/MeshValidation.hpp"
+#include "immerse/membrane/NeoHookean.hpp"
+#include "immerse/membrane/Shape.hpp"
+#include "immerse/membrane/Skalak.hpp"
+#include "immerse/membrane/Yeoh.hpp"
+
+namespace immerse {
+
+namespace {
+
+const char* kAxes[3] = {"x", "y", "z"};
+
+Grid make_grid(const io::Config& c) {
+  std::array<Boundary, 3> bc{};
+  for (int d = 0; d < 3; ++d)
+    bc[d] = c.get<std::string>(std::string("boundary.") + kAxes[d]) == "wall" ? Boundary::Wall : Boundary::Periodic;
+  return Grid({c.get<int>("grid.nx"), c.get<int>("grid.ny"), c.get<int>("grid.nz")},
+              {c.get<double>("domain.Lx"), c.get<double>("domain.Ly"), c.get<double>("domain.Lz")}, bc,
+              c.get<Vec3>("domain.origin"));
+}
+
+FluidParams make_fluid(const io::Config& c) {
+  FluidParams p;
+  p.rho = c.get<double>("fluid.rho");
+  p.mu = c.get<double>("fluid.mu");
+  p.body_force = c.get<Vec3>("fluid.body_force");
+  for (int d = 0; d < 3; ++d) {
+    p.wall_lower[d] = c.get<Vec3>(std::string("boundary.") + kAxes[d] + "_lower_velocity");
+    p.wall_upper[d] = c.get<Vec3>(std::string("boundary.") + kAxes[d] + "_upper_velocity");
+  }
+  return p;
+}
+
+SolverSettings make_settings(const io::Config& c) {
+  SolverSettings s;
+  s.theta = c.get<double>("time.theta");
+  s.newton_rtol = c.get<double>("solver.newton_rtol");
+  s.gmres_rtol = c.get<double>("solver.gmres_rtol");
+  s.max_newton_its = c.get<int>("solver.max_newton_its");
+  s.bfgs_memory = c.get<int>("solver.bfgs_memory");
+  s.petsc_options = c.get<std::string>("solver.petsc_options");
+  return s;
+}
+
+Shape shape_of(const io::Config& m, bool reference) {
+  Shape s;
+  if (reference && m.get<std::string>("reference") == "sphere") {
+    s.form = Sphere{m.get<double>("reference_radius")};
+  } else {
+    const std::string kind = m.get<std::string>("shape");
+    if (kind == "sphere") s.form = Sphere{m.get<double>("radius")};
+    else if (kind == "ellipsoid") {
+      const Vec3 ax = m.get<Vec3>("semi_axes");
+      s.form = Ellipsoid{ax.x, ax.y, ax.z};
+    } else if (kind == "oblate") {
+      s.form = OblateSpheroid{m.get<double>("radius"), m.get<double>("aspect_ratio"), m.get<double>("inclination")};
+    } else {
+      BiconcaveCell rbc;
+      rbc.R0 = m.get<double>("R0");
+      s.form = rbc;
+    }
+  }
+  const Vec3 axis = m.get<Vec3>("rotation_axis");
+  const double angle = m.get<double>("rotation_angle");
+  if (angle != 0.0) {
+    require(norm(axis) > 0, "rotation_axis", "a non-zero vector");
+    s.placement.rotation = rotation_about(axis, angle);
+  }
+  s.placement.translation = m.get<Vec3>("center");
+  return s;
+}
+
+MaterialLaw law_of(const io::Config& m) {
+  const std::string law = m.get<std::string>("law");
+  if (law == "neo_hookean") return NeoHookean(m.get<double>("Es"));
+  if (law == "yeoh") return Yeoh(m.get<double>("C10"), m.get<double>("C30"));
+  return Skalak(m.get<double>("C11"), m.get<double>("C21"));
+}
+
+std::string membrane_name(std::size_t m) { return "membrane[" + std::to_string(m) + "]"; }
+
+}  // namespace
+
+Simulation::Simulation(const io::Config& config)
+    : config_(config),
+      grid_(make_grid(config)),
+      fluid_(grid_, make_fluid(config)),
+      coupler_(grid_, delta_kernel(config.get<std::string>("coupling.kernel"))),
+      stepper_(config.get<double>("time.dt"), config.get<double>("time.dt_min")) {
+  build_membranes();
+  check_geometry();
+  std::vector<const ElasticMembrane*> ms;
+  for (auto& m : membranes_) ms.push_back(m.get());
+  op_ = std::make_unique<ImmersedBoundaryOperator>(fluid_, coupler_, ms, initial_, initial_fluid_state());
+  integrator_ = make_integrator(config.get<std::string>("time.scheme"), make_settings(config));
+}
+
+void Simulation::build_membranes() {
+  for (std::size_t i = 0; i < config_.count("membrane"); ++i) {
+    const io::Config& m = config_.entry("membrane", i);
+    const std::string name = membrane_name(i);
+    try {
+      const std::string family = m.get<std::string>("mesh.family");
+      const int level = m.get<int>("mesh.level");
+      Mesh mesh;
+      std::vector<Vec3> unit;
+      if (family == "file") {
+        const std::string file = m.get<std::string>("mesh.file");
+        require(!file.empty(), "mesh.file", "a Gmsh file name when mesh.family = \"file\"");
+        mesh = read_gmsh(file);
+        unit = mesh.nodes;  // a user's mesh is used as it is: shape keys place it (sphere radius scales it)
+        for (auto& p : unit) p = normalized(p);
+      } else {
+        mesh = family == "icosahedral" ? icosahedral_sphere(level) : octahedral_sphere(level);
+        unit = mesh.nodes;
+      }
+      auto initial = map_sphere(shape_of(m, false), unit);
+      auto reference = map_sphere(shape_of(m, true), unit);
+      if (m.get<std::string>("reference") == "sphere") {
+        const Vec3 c = m.get<Vec3>("center");
+        for (auto& p : reference) p += c - shape_of(m, true).placement.translation;
+      }
+      mesh.nodes = initial;
+      validate_closed_mesh(mesh, name);
+      Bending bending{m.get<double>("kappa_B"), m.get<std::string>("bending_reference") == "rest"
+                                                     ? ReferenceCurvature::RestShape
+                                                     : ReferenceCurvature::Zero};
+      membranes_.push_back(std::make_unique<ElasticMembrane>(
+          mesh, reference, law_of(m), bending,
+          m.get<std::string>("force") == "energy" ? ForceMethod::Energy : ForceMethod::Contour));
+      meshes_.push_back(std::move(mesh));
+      references_.push_back(std::move(reference));
+      initial_.push_back(std::move(initial));
+    } catch (const InputError& e) {
+      throw InputError(name + "." + e.what());
+    }
+  }
+}
+
+void Simulation::check_geometry() const {
+  const double h = grid_.h();
+  std::vector<std::pair<Vec3, Vec3>> boxes;
+  for (std::size_t m = 0; m < initial_.size(); ++m) {
+    const auto& X = initial_[m];
+    try {
+      check_nodes_in_domain(grid_, X);
+    } catch (const SimulationError& e) {
+      throw InputError(membrane_name(m) + " lies outside the box: " + e.what());
+    }
+    const double d = min_wall_distance(grid_, X);
+    if (d < h) {
+      std::ostringstream s;
+      s << membrane_name(m) << " comes within " << d << " m of a wall: must keep at least one cell (" << h
+        << " m) clear for the delta function";
+      throw InputError(s.str());
+    }
+    Vec3 lo = X[0], hi = X[0];
+    for (const auto& p : X)
+      for (int k = 0; k < 3; ++k) lo[k] = std::min(lo[k], p[k]), hi[k] = std::max(hi[k], p[k]);
+    for (std::size_t o = 0; o < boxes.size(); ++o) {
+      bool overlap = true;
+      for (int k = 0; k < 3; ++k) overlap = overlap && lo[k] < boxes[o].second[k] && boxes[o].first[k] < hi[k];
+      if (overlap) throw InputError(membrane_name(m) + " overlaps " + membrane_name(o) + " (their bounding boxes intersect)");
+    }
+    boxes.emplace_back(lo, hi);
+  }
+}
+
+FluidState Simulation::initial_fluid_state() const {
+  FluidState s = fluid_.initial_state();
+  if (config_.get<std::string>("fluid.initial") != "couette") return s;
+  // The linear profile between the walls of the first wall axis: u = u_lower + (u_upper - u_lower) (x_a - o_a) / L_a.
+  const auto& p = fluid_.params();
+  int a = -1;
+  for (int d = 0; d < 3 && a < 0; ++d)
+    if (!grid_.periodic(d)) a = d;
+  require(a >= 0, "fluid.initial", "\"rest\" when no axis has walls (\"couette\" needs walls)");
+  for (int d = 0; d < 3; ++d) {
+    auto& u = s.u[d];
+    for (int k = 0; k < u.nz(); ++k)
+      for (int j = 0; j < u.ny(); ++j)
+        for (int i = 0; i < u.nx(); ++i) {
+          const Vec3 x = grid_.face_position(d, i, j, k);
+          const double f = (x[a] - grid_.origin()[a]) / grid_.length(a);
+          u(i, j, k) = p.wall_lower[a][d] + (p.wall_upper[a][d] - p.wall_lower[a][d]) * f;
+        }
+  }
+  fluid_.apply_wall_values(s.u);
+  return s;
+}
+
+bool Simulation::finished() const { return time() >= config_.get<double>("time.end") * (1 - 1e-12); }
+
+StepRecord Simulation::advance(const std::function<void(const std::string&)>& log) {
+  const auto t0 = std::chrono::steady_clock::now();
+  const double remaining = config_.get<double>("time.end") - time();
+  StepRecord r;
+  std::ostringstream where;
+  where.precision(10);
+  where << "step " << step_ + 1 << ", t = " << time() << ": ";
+  try {
+    const auto acc = stepper_.advance(*integrator_, *op_, remaining,
+                                      [&](const std::string& msg) { log(where.str() + msg); });
+    r.stats = acc.stats;
+    r.dt = acc.dt;
+    r.rejected = acc.rejected;
+  } catch (const SimulationError& e) {
+    throw SimulationError(where.str() + e.what());
+  }
+  ++step_;
+  r.step = step_;
+  r.time = time();
+  r.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  check_stability(r);
+  return r;
+}
+
+void Simulation::check_stability(const StepRecord& r) const {
+  const double vmax = config_.get<double>("time.max_speed");
+  for (std::size_t m = 0; m < num_membranes(); ++m) {
+    const auto X = op_->membrane_positions(m);
+    const auto U = op_->membrane_velocities(m);
+    for (std::size_t i = 0; i < X.size(); ++i) {
+      const char* what = !isfinite(X[i]) ? "position is not finite"
+                         : !isfinite(U[i]) ? "velocity is not finite"
+                         : norm(U[i]) > vmax ? "speed exceeds time.max_speed (runaway)"
+                                             : nullptr;
+      if (!what) continue;
+      std::ostringstream s;
+      s.precision(10);
+      s << "unstable at step " << r.step << ", t = " << r.time << ": " << membrane_name(m) << " node " << i << " "
+        << what << " (|u| = " << norm(U[i]) << " m/s, bound " << vmax << ")";
+      throw SimulationError(s.str());
+    }
+  }
+}
+
+io::Checkpoint Simulation::checkpoint() const {
+  io::Checkpoint ck;
+  ck.put_string("config", config_.to_toml_string());
+  ck.put_int("step", step_);
+  const FluidState& f = op_->fluid_state();
+  for (int d = 0; d < 3; ++d) {
+    const auto& u = f.u[d];
+    const std::vector<std::size_t> shape{std::size_t(u.nz()), std::size_t(u.ny()), std::size_t(u.nx())};
+    ck.put_array("fluid/u" + std::to_string(d), u.values(), shape);
+    ck.put_array("fluid/adv" + std::to_string(d), f.adv[d].values(), shape);
+  }
+  ck.put_array("fluid/p", f.p.values(), {std::size_t(f.p.nz()), std::size_t(f.p.ny()), std::size_t(f.p.nx())});
+  ck.put_double("fluid/dt_prev", f.dt_prev);
+  ck.put_int("fluid/step", f.step);
+  ck.put_double("fluid/time", f.time);
+  for (std::size_t m = 0; m < num_membranes(); ++m) {
+    const auto X = op_->membrane_positions(m);
+    ck.put_array(membrane_name(m) + "/positions", {&X[0].x, &X[0].x + 3 * X.size()}, {X.size(), 3});
+    const auto& R = references_[m];
+    ck.put_array(membrane_name(m) + "/reference", {&R[0].x, &R[0].x + 3 * R.size()}, {R.size(), 3});
+  }
+  ck.put_array("integrator/previous_positions", integrator_->previous_positions());
+  ck.put_double("integrator/previous_dt", integrator_->previous_dt());
+  ck.put_double("stepper/dt", stepper_.dt());
+  ck.put_int("stepper/successes", stepper_.successes());
+  return ck;
+}
+
+void Simulation::restore(const io::Checkpoint& ck) {
+  // The checkpoint's configuration must be this one, up to the end time and the output schedule.
+  const io::Config theirs = config_.schema().parse_string(ck.get_string("config"), "checkpoint");
+  // Compare the resolved TOML texts key by key, leaving out the [output] table and time.end.
+  auto strip = [](const std::string& toml) {
+    std::istringstream in(toml);
+    std::string line, out, section;
+    while (std::getline(in, line)) {
+      if (line.empty() || line[0] == '#') continue;
+      if (line[0] == '[') section = line;
+      if (section == "[output]" || (section == "[time]" && line.rfind("end ", 0) == 0)) continue;
+      out += section + " " + line + "\n";
+    }
+    return out;
+  };
+  const std::string a = strip(theirs.to_toml_string()), b = strip(config_.to_toml_string());
+  if (a != b) {
+    std::istringstream ia(a), ib(b);
+    std::string la, lb;
+    while (std::getline(ia, la) && std::getline(ib, lb) && la == lb) {
+    }
+    throw InputError("checkpoint was written by a different configuration: it has '" + la + "', this run has '" + lb +
+                     "'");
+  }
+  FluidState f = fluid_.initial_state();
+  for (int d = 0; d < 3; ++d) {
+    f.u[d].values() = ck.array("fluid/u" + std::to_string(d));
+    f.adv[d].values() = ck.array("fluid/adv" + std::to_string(d));
+  }
+  f.p.values() = ck.array("fluid/p");
+  f.dt_prev = ck.get_double("fluid/dt_prev");
+  f.step = ck.get_int("fluid/step");
+  f.time = ck.get_double("fluid/time");
+  std::vector<std::vector<Vec3>> X(num_membranes());
+  for (std::size_t m = 0; m < num_membranes(); ++m) {
+    const auto& a3 = ck.array(membrane_name(m) + "/positions");
+    X[m].resize(a3.size() / 3);
+    for (std::size_t i = 0; i < X[m].size(); ++i) X[m][i] = {a3[3 * i], a3[3 * i + 1], a3[3 * i + 2]};
+  }
+  std::vector<const ElasticMembrane*> ms;
+  for (auto& m : membranes_) ms.push_back(m.get());
+  op_ = std::make_unique<ImmersedBoundaryOperator>(fluid_, coupler_, ms, X, std::move(f));
+  integrator_->set_history(ck.array("integrator/previous_positions"), ck.get_double("integrator/previous_dt"));
+  stepper_.set_state(ck.get_double("stepper/dt"), static_cast<int>(ck.get_int("stepper/successes")));
+  step_ = ck.get_int("step");
+}
+
+}  // namespace immerse

@@ -1,0 +1,76 @@
+#pragma once
+// One run: the grid, the fluid, the membranes, their coupling and the time integrator, built from a resolved
+// configuration (RunSchema), advanced step by step. Output is not its business: the Runner schedules callbacks
+// (diagnostics, ParaView frames, checkpoints, progress) around advance().
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "immerse/coupling/IBCoupler.hpp"
+#include "immerse/fluid/NavierStokesSolver.hpp"
+#include "immerse/io/Checkpoint.hpp"
+#include "immerse/io/Config.hpp"
+#include "immerse/membrane/ElasticMembrane.hpp"
+#include "immerse/membrane/Mesh.hpp"
+#include "immerse/simulation/ImmersedBoundaryOperator.hpp"
+#include "immerse/timestep/AdaptiveStepper.hpp"
+#include "immerse/timestep/MembraneIntegrator.hpp"
+
+namespace immerse {
+
+/// What one accepted step did (one row of diagnostics.csv before the membrane columns).
+struct StepRecord {
+  long step = 0;
+  double time = 0, dt = 0;
+  StepStats stats;
+  int rejected = 0;
+  double wall_seconds = 0;
+};
+
+class Simulation {
+ public:
+  /// Builds everything from `config` (already through apply_scenario). Throws InputError on inconsistent input
+  /// (a membrane outside the box or too close to a wall, two membranes overlapping, bad meshes, ...).
+  explicit Simulation(const io::Config& config);
+
+  /// Advances one accepted step (with step halving on failed solves, reported through `log`). Throws
+  /// SimulationError naming step, time, membrane and quantity when the run becomes unstable.
+  StepRecord advance(const std::function<void(const std::string&)>& log);
+  bool finished() const;
+
+  long step() const { return step_; }
+  double time() const { return op_->fluid_state().time; }
+  const io::Config& config() const { return config_; }
+  const Grid& grid() const { return grid_; }
+  const ImmersedBoundaryOperator& op() const { return *op_; }
+  std::size_t num_membranes() const { return meshes_.size(); }
+  const Mesh& mesh(std::size_t m) const { return meshes_[m]; }
+  const ElasticMembrane& membrane(std::size_t m) const { return *membranes_[m]; }
+  const std::vector<Vec3>& reference(std::size_t m) const { return references_[m]; }
+
+  /// Everything needed to continue bitwise identically.
+  io::Checkpoint checkpoint() const;
+  /// Continues from a checkpoint of the same configuration (InputError naming the first differing key otherwise;
+  /// time.end and output.* may differ).
+  void restore(const io::Checkpoint& ck);
+
+ private:
+  void build_membranes();
+  FluidState initial_fluid_state() const;
+  void check_geometry() const;
+  void check_stability(const StepRecord& r) const;
+
+  io::Config config_;
+  Grid grid_;
+  NavierStokesSolver fluid_;
+  IBCoupler coupler_;
+  std::vector<Mesh> meshes_;
+  std::vector<std::vector<Vec3>> references_, initial_;
+  std::vector<std::unique_ptr<ElasticMembrane>> membranes_;
+  std::unique_ptr<ImmersedBoundaryOperator> op_;
+  std::unique_ptr<MembraneIntegrator> integrator_;
+  AdaptiveStepper stepper_;
+  long step_ = 0;
+};
+
+}  // namespace immerse
