@@ -5,7 +5,6 @@
 #include <filesystem>
 #include <fstream>
 #include <numbers>
-#include <regex>
 #include <sstream>
 
 #include "immerse/core/Error.hpp"
@@ -210,22 +209,30 @@ struct HdfRef {
   std::string dims, file, dataset;
 };
 
-// Every <DataItem ... Format="HDF">file:/dataset</DataItem> of an XDMF text.
-std::vector<HdfRef> hdf_refs(const std::string& xml) {
-  static const std::regex item(R"re(<DataItem Dimensions="([0-9 ]+)"[^>]*Format="HDF">([^:<]+):([^<]+)</DataItem>)re");
-  std::vector<HdfRef> out;
-  for (auto it = std::sregex_iterator(xml.begin(), xml.end(), item); it != std::sregex_iterator(); ++it)
-    out.push_back({(*it)[1], (*it)[2], (*it)[3]});
+// The text between `open` and the next `close`, for every occurrence of `open`.
+std::vector<std::string> between(const std::string& xml, const std::string& open, const std::string& close) {
+  std::vector<std::string> out;
+  for (auto a = xml.find(open); a != std::string::npos; a = xml.find(open, a + 1)) {
+    const auto b = a + open.size();
+    out.push_back(xml.substr(b, xml.find(close, b) - b));
+  }
   return out;
 }
 
-std::vector<std::string> times(const std::string& xml) {
-  static const std::regex t(R"re(<Time Value="([^"]+)"/>)re");
-  std::vector<std::string> out;
-  for (auto it = std::sregex_iterator(xml.begin(), xml.end(), t); it != std::sregex_iterator(); ++it)
-    out.push_back((*it)[1]);
+// Every <DataItem Dimensions="..." ... Format="HDF">file:/dataset</DataItem> of an XDMF text.
+std::vector<HdfRef> hdf_refs(const std::string& xml) {
+  std::vector<HdfRef> out;
+  for (const auto& item : between(xml, "<DataItem Dimensions=\"", "</DataItem>")) {
+    const auto fmt = item.find("Format=\"HDF\">");
+    if (fmt == std::string::npos) continue;
+    const std::string ref = item.substr(fmt + 13);
+    const auto colon = ref.find(':');
+    out.push_back({item.substr(0, item.find('"')), ref.substr(0, colon), ref.substr(colon + 1)});
+  }
   return out;
 }
+
+std::vector<std::string> times(const std::string& xml) { return between(xml, "<Time Value=\"", "\"/>"); }
 
 std::string dims_of(const fs::path& file, const std::string& dataset) {
   hdf5::Handle f = hdf5::open_file_readonly(file);

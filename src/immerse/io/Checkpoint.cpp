@@ -131,7 +131,8 @@ bool Checkpoint::operator==(const Checkpoint& o) const {
   for (const auto& [name, a] : arrays_) {
     const auto it = o.arrays_.find(name);
     if (it == o.arrays_.end() || it->second.shape != a.shape || it->second.values.size() != a.values.size() ||
-        std::memcmp(a.values.data(), it->second.values.data(), a.values.size() * sizeof(double)) != 0)
+        (!a.values.empty() &&
+         std::memcmp(a.values.data(), it->second.values.data(), a.values.size() * sizeof(double)) != 0))
       return false;
   }
   for (const auto& [name, v] : doubles_) {
