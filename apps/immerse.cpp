@@ -3,6 +3,7 @@
 #include <iostream>
 
 #include "immerse/core/Error.hpp"
+#include "immerse/simulation/Runner.hpp"
 #include "immerse/timestep/PetscSession.hpp"
 #include "immerse/verify/Runner.hpp"
 
@@ -33,6 +34,17 @@ int main(int argc, char** argv) {
   app.set_version_flag("--version", std::string("immerse ") + IMMERSE_VERSION);
   app.require_subcommand(1);
 
+  immerse::RunOptions run_opts;
+  bool help_config = false;
+  auto* run = app.add_subcommand("run", "Run the experiment described by a TOML file");
+  run->add_option("file", run_opts.file, "Configuration (e.g. scenarios/capsule_shear_quick.toml)");
+  run->add_option("--set", run_opts.sets, "Override a key: --set scenario.G=0.05 (repeatable; dotted names as in the file)");
+  run->add_option("--out", run_opts.out, "Output folder (diagnostics.csv, config.resolved.toml, ParaView frames, checkpoint.h5)")
+      ->capture_default_str();
+  run->add_option("--restart", run_opts.restart, "Continue from a checkpoint written by the same configuration");
+  run->add_flag("--help-config", help_config, "List every configuration key with its default, range and meaning");
+  auto* scenarios = app.add_subcommand("scenarios", "List the bundled scenario files");
+
   auto* verify = app.add_subcommand("verify", "Run a verification study (no NAME: list them; 'all': run every study)");
   std::string study;
   bool quick = false;
@@ -45,7 +57,17 @@ int main(int argc, char** argv) {
     return app.exit(e) == 0 ? 0 : 2;
   }
   try {
+    if (*scenarios) {
+      immerse::list_scenarios(IMMERSE_SOURCE_DIR "/scenarios", std::cout);
+      return 0;
+    }
+    if (*run && help_config) {
+      immerse::print_config_help(std::cout);
+      return 0;
+    }
+    if (*run && run_opts.file.empty()) throw immerse::InputError("run: a configuration FILE.toml is required");
     immerse::PetscSession petsc;
+    if (*run) return immerse::run_command(run_opts, std::cout, std::cerr);
     if (*verify) return run_verify(study, quick);
   } catch (const immerse::InputError& e) {
     std::cerr << "immerse: error: " << e.what() << "\n";

@@ -253,23 +253,23 @@ io::Checkpoint Simulation::checkpoint() const {
   for (int d = 0; d < 3; ++d) {
     const auto& u = f.u[d];
     const std::vector<std::size_t> shape{std::size_t(u.nz()), std::size_t(u.ny()), std::size_t(u.nx())};
-    ck.put_array("fluid/u" + std::to_string(d), u.values(), shape);
-    ck.put_array("fluid/adv" + std::to_string(d), f.adv[d].values(), shape);
+    ck.put_array("fluid.u" + std::to_string(d), u.values(), shape);
+    ck.put_array("fluid.adv" + std::to_string(d), f.adv[d].values(), shape);
   }
-  ck.put_array("fluid/p", f.p.values(), {std::size_t(f.p.nz()), std::size_t(f.p.ny()), std::size_t(f.p.nx())});
-  ck.put_double("fluid/dt_prev", f.dt_prev);
-  ck.put_int("fluid/step", f.step);
-  ck.put_double("fluid/time", f.time);
+  ck.put_array("fluid.p", f.p.values(), {std::size_t(f.p.nz()), std::size_t(f.p.ny()), std::size_t(f.p.nx())});
+  ck.put_double("fluid.dt_prev", f.dt_prev);
+  ck.put_int("fluid.step", f.step);
+  ck.put_double("fluid.time", f.time);
   for (std::size_t m = 0; m < num_membranes(); ++m) {
     const auto X = op_->membrane_positions(m);
-    ck.put_array(membrane_name(m) + "/positions", {&X[0].x, &X[0].x + 3 * X.size()}, {X.size(), 3});
+    ck.put_array(membrane_name(m) + ".positions", {&X[0].x, &X[0].x + 3 * X.size()}, {X.size(), 3});
     const auto& R = references_[m];
-    ck.put_array(membrane_name(m) + "/reference", {&R[0].x, &R[0].x + 3 * R.size()}, {R.size(), 3});
+    ck.put_array(membrane_name(m) + ".reference", {&R[0].x, &R[0].x + 3 * R.size()}, {R.size(), 3});
   }
-  ck.put_array("integrator/previous_positions", integrator_->previous_positions());
-  ck.put_double("integrator/previous_dt", integrator_->previous_dt());
-  ck.put_double("stepper/dt", stepper_.dt());
-  ck.put_int("stepper/successes", stepper_.successes());
+  ck.put_array("integrator.previous_positions", integrator_->previous_positions());
+  ck.put_double("integrator.previous_dt", integrator_->previous_dt());
+  ck.put_double("stepper.dt", stepper_.dt());
+  ck.put_int("stepper.successes", stepper_.successes());
   return ck;
 }
 
@@ -299,24 +299,24 @@ void Simulation::restore(const io::Checkpoint& ck) {
   }
   FluidState f = fluid_.initial_state();
   for (int d = 0; d < 3; ++d) {
-    f.u[d].values() = ck.array("fluid/u" + std::to_string(d));
-    f.adv[d].values() = ck.array("fluid/adv" + std::to_string(d));
+    f.u[d].values() = ck.array("fluid.u" + std::to_string(d));
+    f.adv[d].values() = ck.array("fluid.adv" + std::to_string(d));
   }
-  f.p.values() = ck.array("fluid/p");
-  f.dt_prev = ck.get_double("fluid/dt_prev");
-  f.step = ck.get_int("fluid/step");
-  f.time = ck.get_double("fluid/time");
+  f.p.values() = ck.array("fluid.p");
+  f.dt_prev = ck.get_double("fluid.dt_prev");
+  f.step = ck.get_int("fluid.step");
+  f.time = ck.get_double("fluid.time");
   std::vector<std::vector<Vec3>> X(num_membranes());
   for (std::size_t m = 0; m < num_membranes(); ++m) {
-    const auto& a3 = ck.array(membrane_name(m) + "/positions");
+    const auto& a3 = ck.array(membrane_name(m) + ".positions");
     X[m].resize(a3.size() / 3);
     for (std::size_t i = 0; i < X[m].size(); ++i) X[m][i] = {a3[3 * i], a3[3 * i + 1], a3[3 * i + 2]};
   }
   std::vector<const ElasticMembrane*> ms;
   for (auto& m : membranes_) ms.push_back(m.get());
   op_ = std::make_unique<ImmersedBoundaryOperator>(fluid_, coupler_, ms, X, std::move(f));
-  integrator_->set_history(ck.array("integrator/previous_positions"), ck.get_double("integrator/previous_dt"));
-  stepper_.set_state(ck.get_double("stepper/dt"), static_cast<int>(ck.get_int("stepper/successes")));
+  integrator_->set_history(ck.array("integrator.previous_positions"), ck.get_double("integrator.previous_dt"));
+  stepper_.set_state(ck.get_double("stepper.dt"), static_cast<int>(ck.get_int("stepper.successes")));
   step_ = ck.get_int("step");
 }
 

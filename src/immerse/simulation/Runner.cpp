@@ -1,0 +1,234 @@
+#include "immerse/simulation/Runner.hpp"
+
+#include <unistd.h>
+
+#include <chrono>
+#include <csignal>
+#include <cstdio>
+#include <fstream>
+#include <iomanip>
+#include <iostream>
+#include <sstream>
+
+#include "immerse/core/Error.hpp"
+#include "immerse/io/AtomicFile.hpp"
+#include "immerse/io/CsvWriter.hpp"
+#include "immerse/io/XdmfWriter.hpp"
+#include "immerse/membrane/Geometry.hpp"
+#include "immerse/simulation/Callback.hpp"
+#include "immerse/simulation/RunSchema.hpp"
+#include "immerse/simulation/Scenario.hpp"
+#include "immerse/simulation/ShearPlaneProfile.hpp"
+#include "immerse/simulation/Simulation.hpp"
+
+namespace immerse {
+
+namespace {
+
+volatile std::sig_atomic_t g_stop_signal = 0;
+extern "C" void on_signal(int sig) { g_stop_signal = sig; }
+
+const std::vector<std::string> kStepColumns{"step",         "time",     "dt",       "newton_its",
+                                            "gmres_its",    "fluid_solves", "residual", "wall_s"};
+const std::vector<std::string> kMembraneColumns{"volume", "area", "cx", "cy", "cz", "a1", "a2", "a3", "D_xz", "theta"};
+
+std::vector<std::string> diagnostics_columns(std::size_t membranes) {
+  auto cols = kStepColumns;
+  for (std::size_t m = 0; m < membranes; ++m) {
+    std::string prefix;
+    if (membranes > 1) prefix.append("m").append(std::to_string(m)).append("_");
+    for (const auto& c : kMembraneColumns) cols.push_back(prefix + c);
+  }
+  return cols;
+}
+
+std::vector<double> diagnostics_row(const Simulation& sim, const StepRecord& r) {
+  std::vector<double> row{double(r.step),
+                          r.time,
+                          r.dt,
+                          double(r.stats.newton_its),
+                          double(r.stats.gmres_its),
+                          double(r.stats.fluid_solves),
+                          r.stats.residual,
+                          r.wall_seconds};
+  for (std::size_t m = 0; m < sim.num_membranes(); ++m) {
+    const auto X = sim.op().membrane_positions(m);
+    const MembraneGeometry g = measure(sim.mesh(m), X);
+    const ShearPlaneProfile p = shear_plane_profile(sim.mesh(m), X, g.centroid);
+    row.insert(row.end(), {g.volume, g.area, g.centroid.x, g.centroid.y, g.centroid.z, g.semi_axes[0], g.semi_axes[1],
+                           g.semi_axes[2], p.D_xz, p.theta});
+  }
+  return row;
+}
+
+void write_frame(io::XdmfWriter& writer, const Simulation& sim) {
+  std::vector<std::vector<Vec3>> X, U, F;
+  std::vector<std::vector<double>> tau1, tau2;
+  std::vector<io::SurfaceFrame> frames;
+  for (std::size_t m = 0; m < sim.num_membranes(); ++m) {
+    X.push_back(sim.op().membrane_positions(m));
+    U.push_back(sim.op().membrane_velocities(m));
+    F.emplace_back();
+    sim.membrane(m).compute_force(X.back(), F.back());
+    const auto strain = sim.membrane(m).node_strain(X.back());
+    tau1.emplace_back();
+    tau2.emplace_back();
+    for (const auto& s : strain) tau1.back().push_back(s.tau1), tau2.back().push_back(s.tau2);
+  }
+  for (std::size_t m = 0; m < sim.num_membranes(); ++m)
+    frames.push_back({"membrane" + std::to_string(m),
+                      X[m],
+                      sim.mesh(m).elements,
+                      {{"force", F[m]}, {"velocity", U[m]}},
+                      {{"tension_1", tau1[m]}, {"tension_2", tau2[m]}}});
+  const auto& f = sim.op().fluid_state();
+  const io::FluidFrame fluid{sim.grid(), f.u, f.p};
+  writer.write_frame(sim.time(), frames, sim.config().get<bool>("output.fluid_fields") ? &fluid : nullptr);
+}
+
+// Keeps the header and the rows up to `step` of a diagnostics file (a restart continues after the checkpoint).
+void truncate_diagnostics(const std::filesystem::path& path, long step) {
+  std::ifstream in(path);
+  if (!in) return;
+  std::string line, kept;
+  bool header = true;
+  while (std::getline(in, line)) {
+    if (header || std::stol(line) <= step) kept += line + "\n";
+    header = false;
+  }
+  io::AtomicFile::write(path, kept);
+}
+
+class Progress {
+ public:
+  Progress(std::ostream& out, double end, double log_seconds)
+      : out_(out), end_(end), every_(log_seconds), tty_(isatty(STDOUT_FILENO)), t0_(clock::now()), last_(t0_) {}
+  void update(const Simulation& sim, long steps_done) {
+    const auto now = clock::now();
+    const double elapsed = std::chrono::duration<double>(now - t0_).count();
+    if (!tty_ && std::chrono::duration<double>(now - last_).count() < every_) return;
+    last_ = now;
+    const double frac = std::min(1.0, sim.time() / end_), rate = double(steps_done) / std::max(elapsed, 1e-9);
+    const double eta = frac > 0 ? elapsed * (1 - frac) / frac : 0;
+    std::ostringstream s;
+    s << std::setprecision(4) << "t = " << sim.time() << " / " << end_ << "  step " << sim.step() << "  "
+      << rate << " steps/s  ETA " << std::fixed << std::setprecision(0) << eta << " s";
+    if (tty_) {
+      const int width = 30, done = static_cast<int>(frac * width);
+      out_ << "\r[" << std::string(done, '#') << std::string(width - done, '.') << "] " << s.str() << "   " << std::flush;
+    } else {
+      out_ << "progress: " << s.str() << "\n" << std::flush;
+    }
+  }
+  void finish() {
+    if (tty_) out_ << "\n";
+  }
+
+ private:
+  using clock = std::chrono::steady_clock;
+  std::ostream& out_;
+  double end_, every_;
+  bool tty_;
+  clock::time_point t0_, last_;
+};
+
+}  // namespace
+
+void print_config_help(std::ostream& out) { run_schema().print_help(out); }
+
+void list_scenarios(const std::filesystem::path& dir, std::ostream& out) {
+  std::vector<std::filesystem::path> files;
+  if (std::filesystem::is_directory(dir))
+    for (const auto& e : std::filesystem::directory_iterator(dir))
+      if (e.path().extension() == ".toml") files.push_back(e.path());
+  std::sort(files.begin(), files.end());
+  out << "Bundled scenarios in " << dir.string() << " (run one with: immerse run FILE.toml):\n";
+  for (const auto& f : files) {
+    std::ifstream in(f);
+    std::string first;
+    std::getline(in, first);
+    if (first.rfind("#", 0) == 0) first = first.substr(first.find_first_not_of("# "));
+    out << "  " << std::left << std::setw(34) << f.filename().string() << first << "\n";
+  }
+}
+
+int run_command(const RunOptions& options, std::ostream& out, std::ostream& err) {
+  // 1. Everything that can be wrong with the input is found before anything is written.
+  const io::ConfigSchema schema = run_schema();
+  const io::Config config = apply_scenario(schema.parse_file(options.file, options.sets));
+  Simulation sim(config);
+  if (!options.restart.empty()) sim.restore(io::Checkpoint::read(options.restart));
+  std::filesystem::create_directories(options.out);
+  const std::filesystem::path dir = options.out;
+
+  out << "# immerse " << IMMERSE_VERSION << ": " << options.file.string() << " -> " << dir.string() << "\n"
+      << "# resolved configuration (saved as config.resolved.toml)\n"
+      << config.to_toml_string() << std::flush;
+  config.save(dir / "config.resolved.toml");
+
+  const bool restarted = !options.restart.empty();
+  if (restarted) truncate_diagnostics(dir / "diagnostics.csv", sim.step());
+  io::CsvWriter csv(dir / "diagnostics.csv", diagnostics_columns(sim.num_membranes()),
+                    restarted ? io::CsvWriter::Mode::Append : io::CsvWriter::Mode::Create);
+  const long fields_every = config.get<int>("output.fields_every");
+  int first_frame = 0;
+  if (restarted && fields_every > 0) first_frame = static_cast<int>(sim.step() / fields_every) + 1;
+  io::XdmfWriter frames(dir, first_frame);
+  StepRecord last;
+
+  std::vector<Callback> callbacks{
+      {"diagnostics", config.get<int>("output.diagnostics_every"), false, true,
+       [&](const Simulation& s) { csv.row(diagnostics_row(s, last)); }},
+      {"fields", fields_every, !restarted && fields_every > 0, fields_every > 0,
+       [&](const Simulation& s) { write_frame(frames, s); }},
+      {"checkpoint", config.get<int>("output.checkpoint_every"), false, true,
+       [&](const Simulation& s) { s.checkpoint().write(dir / "checkpoint.h5"); }},
+  };
+  for (auto& c : callbacks)
+    if (c.at_start) c.act(sim);
+
+  std::signal(SIGINT, on_signal);
+  std::signal(SIGTERM, on_signal);
+  Progress progress(out, config.get<double>("time.end"), config.get<double>("output.log_seconds"));
+  auto log = [&](const std::string& msg) { out << "\n" << msg << "\n"; };
+  int status = 0;
+  long done = 0;
+  try {
+    while (!sim.finished()) {
+      last = sim.advance(log);
+      ++done;
+      for (auto& c : callbacks)
+        if (c.due(sim.step())) c.act(sim);
+      progress.update(sim, done);
+      if (g_stop_signal) {
+        status = 4;
+        break;
+      }
+    }
+  } catch (const SimulationError& e) {
+    progress.finish();
+    err << "immerse: run stopped: " << e.what() << "\n";
+    status = 3;
+  }
+  progress.finish();
+  // The last state (the last accepted step) is always saved, whatever ended the run.
+  for (auto& c : callbacks)
+    if (c.at_end && !(c.due(sim.step()) && status == 0 && done > 0)) c.act(sim);
+  if (status == 4) err << "immerse: interrupted by signal " << g_stop_signal << " at step " << sim.step() << ", t = "
+                       << sim.time() << "; checkpoint written to " << (dir / "checkpoint.h5").string() << "\n";
+  std::signal(SIGINT, SIG_DFL);
+  std::signal(SIGTERM, SIG_DFL);
+
+  out << "done: " << sim.step() << " steps, t = " << sim.time() << "\n";
+  for (std::size_t m = 0; m < sim.num_membranes(); ++m) {
+    const auto X = sim.op().membrane_positions(m);
+    const auto g = measure(sim.mesh(m), X);
+    const auto p = shear_plane_profile(sim.mesh(m), X, g.centroid);
+    out << "membrane[" << m << "]: semi-axes " << g.semi_axes[0] << ", " << g.semi_axes[1] << ", " << g.semi_axes[2]
+        << "  volume " << g.volume << "  Taylor deformation D_xz = " << p.D_xz << "  inclination theta = " << p.theta
+        << " rad\n";
+  }
+  return status;
+}
+
+}  // namespace immerse

@@ -1,0 +1,29 @@
+#pragma once
+// `immerse run FILE.toml [--set key=value ...] [--out DIR] [--restart CHECKPOINT]`: reads and validates the whole
+// configuration and builds the run before anything is written; then prints and saves the resolved configuration,
+// runs the time loop with its scheduled callbacks (diagnostics.csv, ParaView frames, checkpoints, progress), and
+// stops cleanly on instability or SIGINT/SIGTERM with a last checkpoint and frame.
+#include <filesystem>
+#include <iosfwd>
+#include <string>
+#include <vector>
+
+namespace immerse {
+
+struct RunOptions {
+  std::filesystem::path file;
+  std::vector<std::string> sets;
+  std::filesystem::path out = "out";
+  std::filesystem::path restart;  ///< empty: start from t = 0
+};
+
+/// Exit status: 0 done, 2 bad input (nothing written), 3 the run became unstable, 4 interrupted by a signal.
+int run_command(const RunOptions& options, std::ostream& out, std::ostream& err);
+
+/// Prints the bundled scenarios (scenarios/*.toml) with the first comment line of each.
+void list_scenarios(const std::filesystem::path& dir, std::ostream& out);
+
+/// Prints every configuration key with its default, allowed values and doc string.
+void print_config_help(std::ostream& out);
+
+}  // namespace immerse
