@@ -37,9 +37,7 @@ FluidState random_state(const NavierStokesSolver& ns, std::mt19937& rng) {
 }
 
 bool same(const Array3& a, const Array3& b) { return a.values() == b.values(); }
-bool same(const FaceField& a, const FaceField& b) {
-  return same(a[0], b[0]) && same(a[1], b[1]) && same(a[2], b[2]);
-}
+bool same(const FaceField& a, const FaceField& b) { return same(a[0], b[0]) && same(a[1], b[1]) && same(a[2], b[2]); }
 
 double inner(const Array3& a, const Array3& b) {
   double s = 0;
@@ -74,7 +72,7 @@ TEST(FluidParams, RejectsNonPositiveDensityViscosityAndTimeStep) {
   } catch (const InputError& e) {
     EXPECT_STREQ(e.what(), "fluid.dt = 0: must be > 0");
   }
-  EXPECT_THROW(ns.step(a, FaceField(g), 0.1, a), InputError);
+  EXPECT_THROW(ns.step(a, FaceField(g), 0.1, a), std::invalid_argument);
 }
 
 TEST(NavierStokesSolver, StepIsPureAndReusesTheOutputStorage) {
@@ -201,9 +199,9 @@ TEST(FastSolver, ReproducesTheTabulatedEigenvectors) {
     const auto s = l == 3 ? g.cell_shape() : g.face_shape(l);
     // x: wall axis (8 cells); y: periodic (6); z: wall axis (10 cells).
     const auto fx = [&](int i) {
-      if (l == 0) return std::sin(pi * kx * i / 8.0);            // face-normal: DST-I
-      if (l == 3) return std::cos(pi * kx * (i + 0.5) / 8.0);    // pressure: DCT-II
-      return std::sin(pi * kx * (i + 0.5) / 8.0);                // cell-centred velocity: DST-II
+      if (l == 0) return std::sin(pi * kx * i / 8.0);          // face-normal: DST-I
+      if (l == 3) return std::cos(pi * kx * (i + 0.5) / 8.0);  // pressure: DCT-II
+      return std::sin(pi * kx * (i + 0.5) / 8.0);              // cell-centred velocity: DST-II
     };
     const auto fz = [&](int k) {
       if (l == 2) return std::sin(pi * kz * k / 10.0);
@@ -272,7 +270,12 @@ TEST(NavierStokesSolver, UniformFlowThroughWallsWithEqualNormalVelocityIsSteady)
   prm.wall_lower[1] = prm.wall_upper[1] = {0.2, 0, 0.3};
   NavierStokesSolver ns(g, prm, FftPlanning::Estimate);
   FluidState a = ns.initial_state(), b;
-  sample_velocity(g, [](const Vec3&) { return Vec3{0.2, 0, 0.3}; }, a.u);
+  sample_velocity(
+      g,
+      [](const Vec3&) {
+        return Vec3{0.2, 0, 0.3};
+      },
+      a.u);
   for (int n = 0; n < 4; ++n) {
     ns.step(a, FaceField(g), 0.05, b);
     std::swap(a, b);
@@ -293,8 +296,10 @@ TEST(NavierStokesSolver, VariableStepAdamsBashforthStaysSecondOrder) {
   const double T = 0.3;
   const auto run = [&](const std::vector<double>& pattern, int repeats) {
     FluidState a = ns.initial_state(), b;
-    sample_velocity(g, [&](const Vec3& x) { return tg.velocity(x, 0); }, a.u);
-    sample_pressure(g, [&](const Vec3& x) { return tg.pressure(x, -0.5 * pattern[0]); }, a.p);
+    sample_velocity(
+        g, [&](const Vec3& x) { return tg.velocity(x, 0); }, a.u);
+    sample_pressure(
+        g, [&](const Vec3& x) { return tg.pressure(x, -0.5 * pattern[0]); }, a.p);
     for (int r = 0; r < repeats; ++r)
       for (double dt : pattern) {
         ns.step(a, FaceField(g), dt, b);

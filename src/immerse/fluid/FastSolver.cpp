@@ -1,7 +1,5 @@
 #include "immerse/fluid/FastSolver.hpp"
 
-#include "immerse/fluid/MacGeom.hpp"
-
 #include <fftw3.h>
 #include <omp.h>
 
@@ -9,6 +7,8 @@
 #include <mutex>
 #include <numbers>
 #include <stdexcept>
+
+#include "immerse/fluid/MacGeom.hpp"
 
 namespace immerse {
 

@@ -16,7 +16,7 @@ struct MacGeom {
   std::array<int, 3> n{};
   std::array<bool, 3> periodic{};
   double h = 1;
-  double inv_h = 1, inv_h2 = 1;  // 1/h, 1/h²
+  double inv_h = 1, inv_h2 = 1;      // 1/h, 1/h²
   std::array<Vec3, 3> wall_lower{};  ///< velocity of the lower wall of each wall axis (zero: homogeneous)
   std::array<Vec3, 3> wall_upper{};
 
