@@ -8,6 +8,8 @@
 #include <numbers>
 #include <stdexcept>
 
+#include "immerse/fluid/MacGeom.hpp"
+
 namespace immerse {
 
 namespace {
@@ -63,13 +65,14 @@ FastSolver::FastSolver(const Grid& grid, Layout layout, FftPlanning planning) : 
     }
   }
   const std::size_t total = static_cast<std::size_t>(m_[0]) * m_[1] * m_[2];
+  threaded_ = static_cast<long>(total) >= MacGeom::kMinCellsForThreads;
   buf_ = fftw_alloc_real(total);
   if (buf_ == nullptr) throw std::bad_alloc();
   // Array3 is x fastest: in FFTW's row-major terms the dimensions are {z, y, x}.
   const int dims[3] = {m_[2], m_[1], m_[0]};
   const fftw_r2r_kind kf[3] = {fwd[2], fwd[1], fwd[0]}, kb[3] = {bwd[2], bwd[1], bwd[0]};
   const unsigned flags = planning == FftPlanning::Measure ? FFTW_MEASURE : FFTW_ESTIMATE;
-  fftw_plan_with_nthreads(omp_get_max_threads());
+  fftw_plan_with_nthreads(threaded_ ? omp_get_max_threads() : 1);
   forward_ = fftw_plan_r2r(3, dims, buf_, buf_, kf, flags);
   backward_ = fftw_plan_r2r(3, dims, buf_, buf_, kb, flags);
   if (forward_ == nullptr || backward_ == nullptr) throw std::runtime_error("FFTW could not plan a fast solver");
@@ -85,7 +88,7 @@ void FastSolver::solve(Array3& x, double alpha, double beta) {
   const int mx = m_[0], my = m_[1], mz = m_[2];
   const int ox = lo_[0], oy = lo_[1], oz = lo_[2];
   double* b = buf_;
-#pragma omp parallel for collapse(2) schedule(static)
+#pragma omp parallel for collapse(2) schedule(static) if (threaded_)
   for (int k = 0; k < mz; ++k)
     for (int j = 0; j < my; ++j)
       for (int i = 0; i < mx; ++i) b[i + mx * (j + my * static_cast<std::size_t>(k))] = x(i + ox, j + oy, k + oz);
@@ -94,7 +97,7 @@ void FastSolver::solve(Array3& x, double alpha, double beta) {
   const double* ly = lambda_[1].data();
   const double* lz = lambda_[2].data();
   const double norm = normalization_;
-#pragma omp parallel for collapse(2) schedule(static)
+#pragma omp parallel for collapse(2) schedule(static) if (threaded_)
   for (int k = 0; k < mz; ++k)
     for (int j = 0; j < my; ++j)
       for (int i = 0; i < mx; ++i) {
@@ -103,7 +106,7 @@ void FastSolver::solve(Array3& x, double alpha, double beta) {
         v = den == 0.0 ? 0.0 : v / den;
       }
   fftw_execute(backward_);
-#pragma omp parallel for collapse(2) schedule(static)
+#pragma omp parallel for collapse(2) schedule(static) if (threaded_)
   for (int k = 0; k < mz; ++k)
     for (int j = 0; j < my; ++j)
       for (int i = 0; i < mx; ++i) x(i + ox, j + oy, k + oz) = b[i + mx * (j + my * static_cast<std::size_t>(k))];

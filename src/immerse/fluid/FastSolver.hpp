@@ -13,8 +13,8 @@
 // denominator (the constant null mode of the periodic/Neumann Poisson problem) gives a zero coefficient.
 //
 // One in-place 3D r2r plan pair per solver, created once (see FftPlanning) and executed with FFTW threads
-// (omp_get_max_threads() at construction). Not reentrant: solve() uses an internal buffer.
-// A distributed (FFTW-MPI) backend can replace this class behind the same solve().
+// (omp_get_max_threads() at construction; one thread below MacGeom::kMinCellsForThreads unknowns). Not reentrant:
+// solve() uses an internal buffer. A distributed (FFTW-MPI) backend can replace this class behind the same solve().
 #include <array>
 #include <vector>
 
@@ -58,7 +58,8 @@ class FastSolver {
   Layout layout_;
   std::array<int, 3> m_{}, lo_{};
   std::array<std::vector<double>, 3> lambda_;  // eigenvalues of the 3-point second difference per axis
-  double normalization_ = 1;                    // product over axes of N (DFT) or 2N (others)
+  double normalization_ = 1;                   // product over axes of N (DFT) or 2N (others)
+  bool threaded_ = false;
   double* buf_ = nullptr;
   fftw_plan_s* forward_ = nullptr;
   fftw_plan_s* backward_ = nullptr;

@@ -65,8 +65,7 @@ void apply_operator(const Grid& grid, Layout layout, const Array3& x, double alp
   });
 }
 
-double relative_residual(const Grid& grid, Layout layout, const Array3& x, const Array3& b, double alpha,
-                         double beta) {
+double relative_residual(const Grid& grid, Layout layout, const Array3& x, const Array3& b, double alpha, double beta) {
   Array3 ax;
   apply_operator(grid, layout, x, alpha, beta, ax);
   const MacGeom g(grid);
@@ -83,9 +82,7 @@ ErrorNorms velocity_error(const Grid& grid, const FaceField& u, const std::funct
   const MacGeom g(grid);
   Accumulator acc;
   for (int d = 0; d < 3; ++d)
-    serial_faces(g, d, [&](int i, int j, int k) {
-      acc.add(u[d](i, j, k) - exact(grid.face_position(d, i, j, k))[d]);
-    });
+    serial_faces(g, d, [&](int i, int j, int k) { acc.add(u[d](i, j, k) - exact(grid.face_position(d, i, j, k))[d]); });
   return acc.norms();
 }
 

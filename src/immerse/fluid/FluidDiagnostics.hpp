@@ -22,8 +22,7 @@ double max_abs_velocity(const Grid& grid, const FaceField& u);
 void apply_operator(const Grid& grid, Layout layout, const Array3& x, double alpha, double beta, Array3& out);
 
 /// max |(α I + β ∇_h²) x − b| / max |b| over the unknowns of `layout`.
-double relative_residual(const Grid& grid, Layout layout, const Array3& x, const Array3& b, double alpha,
-                         double beta);
+double relative_residual(const Grid& grid, Layout layout, const Array3& x, const Array3& b, double alpha, double beta);
 
 struct ErrorNorms {
   double l2 = 0;   ///< root mean square over the points

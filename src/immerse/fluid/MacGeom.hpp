@@ -16,7 +16,7 @@ struct MacGeom {
   std::array<int, 3> n{};
   std::array<bool, 3> periodic{};
   double h = 1;
-  double inv_h = 1, inv_h2 = 1;  // 1/h, 1/h²
+  double inv_h = 1, inv_h2 = 1;      // 1/h, 1/h²
   std::array<Vec3, 3> wall_lower{};  ///< velocity of the lower wall of each wall axis (zero: homogeneous)
   std::array<Vec3, 3> wall_upper{};
 
@@ -29,6 +29,11 @@ struct MacGeom {
     wall_upper = p.wall_upper;
   }
 
+  /// Whether loops over this grid are worth spreading over OpenMP threads (below ~32³ cells the fork/join
+  /// costs more than the work).
+  bool threaded() const { return static_cast<long>(n[0]) * n[1] * n[2] >= kMinCellsForThreads; }
+  static constexpr long kMinCellsForThreads = 32768;
+
   /// First unknown index of velocity component d along axis a (the end is always n[a], exclusive).
   int first(int d, int a) const { return (a == d && !periodic[a]) ? 1 : 0; }
 };
@@ -37,7 +42,7 @@ struct MacGeom {
 template <class F>
 void for_each_face(const MacGeom& g, int d, F&& f) {
   const int i0 = g.first(d, 0), j0 = g.first(d, 1), k0 = g.first(d, 2);
-#pragma omp parallel for collapse(2) schedule(static)
+#pragma omp parallel for collapse(2) schedule(static) if (g.threaded())
   for (int k = k0; k < g.n[2]; ++k)
     for (int j = j0; j < g.n[1]; ++j)
       for (int i = i0; i < g.n[0]; ++i) f(i, j, k);
@@ -46,7 +51,7 @@ void for_each_face(const MacGeom& g, int d, F&& f) {
 /// Calls f(i, j, k) for every cell.
 template <class F>
 void for_each_cell(const MacGeom& g, F&& f) {
-#pragma omp parallel for collapse(2) schedule(static)
+#pragma omp parallel for collapse(2) schedule(static) if (g.threaded())
   for (int k = 0; k < g.n[2]; ++k)
     for (int j = 0; j < g.n[1]; ++j)
       for (int i = 0; i < g.n[0]; ++i) f(i, j, k);

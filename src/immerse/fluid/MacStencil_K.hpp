@@ -142,8 +142,10 @@ inline double laplacian_cell_neumann(const Array3& phi, const MacGeom& g, const 
     for (int sgn = -1; sgn <= 1; sgn += 2) {
       Index r = q;
       const int m = q[e] + sgn;
-      if (g.periodic[e]) r[e] = wrap(m, g.n[e]);
-      else if (m >= 0 && m < g.n[e]) r[e] = m;
+      if (g.periodic[e])
+        r[e] = wrap(m, g.n[e]);
+      else if (m >= 0 && m < g.n[e])
+        r[e] = m;
       s += at(phi, r) - c;
     }
   return s * g.inv_h2;

@@ -1,6 +1,7 @@
 #include "immerse/fluid/NavierStokesSolver.hpp"
 
 #include <cmath>
+#include <stdexcept>
 
 #include "immerse/core/Error.hpp"
 #include "immerse/fluid/MacStencil_K.hpp"
@@ -24,7 +25,11 @@ void ensure_shape(Array3& a, const Grid& g) {
 }  // namespace
 
 NavierStokesSolver::NavierStokesSolver(const Grid& grid, const FluidParams& params, FftPlanning planning)
-    : grid_(grid), params_(params), geom_(grid, params), ustar_(grid), div_(grid.n(0), grid.n(1), grid.n(2)),
+    : grid_(grid),
+      params_(params),
+      geom_(grid, params),
+      ustar_(grid),
+      div_(grid.n(0), grid.n(1), grid.n(2)),
       phi_(grid.n(0), grid.n(1), grid.n(2)) {
   params_.validate(grid_);
   for (int l = 0; l < 4; ++l) solvers_[l] = std::make_unique<FastSolver>(grid_, static_cast<Layout>(l), planning);
@@ -55,8 +60,8 @@ void NavierStokesSolver::apply_wall_values(FaceField& u) const {
 }
 
 void NavierStokesSolver::step(const FluidState& in, const FaceField& force, double dt, FluidState& out) {
-  require(std::isfinite(dt) && dt > 0, "fluid.dt", dt, "> 0");
-  require(&in != &out, "NavierStokesSolver::step", "given different input and output states");
+  if (!(std::isfinite(dt) && dt > 0)) require(false, "fluid.dt", dt, "> 0");  // (no strings built when valid)
+  if (&in == &out) throw std::invalid_argument("NavierStokesSolver::step: `in` and `out` must be different states");
   ensure_shape(out.u, grid_);
   ensure_shape(out.adv, grid_);
   ensure_shape(out.p, grid_);
@@ -105,9 +110,8 @@ void NavierStokesSolver::step(const FluidState& in, const FaceField& force, doub
     });
   }
   apply_wall_values(out.u);
-  for_each_cell(g, [&](int i, int j, int k) {
-    out.p(i, j, k) = in.p(i, j, k) + phi_(i, j, k) - 0.5 * mu * div_(i, j, k);
-  });
+  for_each_cell(
+      g, [&](int i, int j, int k) { out.p(i, j, k) = in.p(i, j, k) + phi_(i, j, k) - 0.5 * mu * div_(i, j, k); });
 
   out.dt_prev = dt;
   out.step = in.step + 1;
