@@ -14,8 +14,13 @@ struct Callback {
   bool at_start = false;  ///< also run before the first step
   bool at_end = false;    ///< also run after the last step (if the last step was not already scheduled)
   std::function<void(const Simulation&)> act;
+  long last_step = -1;  ///< step at which it last ran
 
   bool due(long step) const { return every > 0 && step % every == 0; }
+  void run(const Simulation& sim, long step) {
+    act(sim);
+    last_step = step;
+  }
 };
 
 }  // namespace immerse

@@ -33,6 +33,7 @@ ImmersedBoundaryOperator::ImmersedBoundaryOperator(NavierStokesSolver& fluid, IB
   offset_.push_back(X_.size());
   F_.resize(X_.size());
   U_.resize(X_.size());
+  applied_.assign(X_.size(), Vec3{});
   membrane_force_density(X_, force_start_);
   coupler_.interpolate_velocity(committed_.u, X_, U_);
 }
@@ -47,7 +48,7 @@ void ImmersedBoundaryOperator::membrane_force_density(std::span<const Vec3> X, F
     } catch (const SimulationError& e) {
       throw SimulationError("membrane " + std::to_string(m) + ": " + e.what());
     }
-    std::copy(Fm_[m].begin(), Fm_[m].end(), F_.begin() + static_cast<std::ptrdiff_t>(offset_[m]));
+    for (std::size_t i = 0; i < Fm_[m].size(); ++i) F_[offset_[m] + i] = Fm_[m][i] + applied_[offset_[m] + i];
   }
   coupler_.spread_force(X, F_, f);
 }
@@ -86,6 +87,12 @@ std::vector<Vec3> ImmersedBoundaryOperator::membrane_positions(std::size_t m) co
 
 std::vector<Vec3> ImmersedBoundaryOperator::membrane_velocities(std::size_t m) const {
   return {U_.begin() + static_cast<std::ptrdiff_t>(offset_[m]), U_.begin() + static_cast<std::ptrdiff_t>(offset_[m + 1])};
+}
+
+void ImmersedBoundaryOperator::set_applied_forces(std::size_t m, const std::vector<Vec3>& F) {
+  if (F.size() != offset_[m + 1] - offset_[m]) throw std::logic_error("set_applied_forces: one force per node");
+  std::copy(F.begin(), F.end(), applied_.begin() + static_cast<std::ptrdiff_t>(offset_[m]));
+  membrane_force_density(X_, force_start_);
 }
 
 double ImmersedBoundaryOperator::min_wall_distance() const { return immerse::min_wall_distance(fluid_.grid(), X_); }

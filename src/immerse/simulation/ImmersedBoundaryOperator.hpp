@@ -43,6 +43,9 @@ class ImmersedBoundaryOperator final : public CoupledOperator {
   std::vector<Vec3> membrane_velocities(std::size_t m) const;
   /// Smallest distance of any node to a wall (infinity without walls).
   double min_wall_distance() const;
+  /// External nodal forces (N) on membrane m, added to its elastic force from now on (e.g. optical tweezers,
+  /// §4.3). The start-of-step force S(X^n) f(X^n) is recomputed with them.
+  void set_applied_forces(std::size_t m, const std::vector<Vec3>& F);
 
  private:
   static std::span<const double> flat(const std::vector<Vec3>& v) {
@@ -63,6 +66,7 @@ class ImmersedBoundaryOperator final : public CoupledOperator {
   FaceField force_start_;  ///< S(X^n) f(X^n)
   FaceField force_, scratch_;
   std::vector<Vec3> F_;                                 ///< nodal forces, all membranes
+  std::vector<Vec3> applied_;                           ///< external nodal forces, all membranes
   std::vector<std::vector<Vec3>> Xm_, Fm_;              ///< per-membrane scratch for compute_force
   std::size_t solves_ = 0;
 };

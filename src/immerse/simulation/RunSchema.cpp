@@ -49,13 +49,23 @@ ConfigSchema membrane_schema() {
 ConfigSchema run_schema() {
   ConfigSchema s;
   s.add_string("scenario.kind", "none",
-               {"none", "oscillating_membrane", "capsule_shear", "oblate_shear", "bending_shear"},
+               {"none", "oscillating_membrane", "capsule_shear", "oblate_shear", "bending_shear", "rbc_stretch"},
                "experiment whose nondimensional groups below set the dimensional values (see scenarios/README.md)");
   s.add_double("scenario.G", 0.05, Range::positive(), "capillary number G = mu k a / E_s of eq. (44) (shear scenarios)");
   s.add_double("scenario.Re", 1e-3, Range::positive(), "Reynolds number Re = rho k a^2 / mu (shear scenarios)");
   s.add_double("scenario.kappa_B_hat", 0.0, Range::non_negative(), "reduced bending modulus kappa_B / (a^2 E_s) (§4.2.3)");
   s.add_double("scenario.aspect_ratio", 1.0, Range::open_closed(0, 1), "oblate_shear: initial aspect ratio b/a (§4.2.2)");
   s.add_double("scenario.theta0", 0.0, Range::closed(-3.2, 3.2), "oblate_shear: initial inclination (rad)");
+  s.add_double("scenario.mu0", 7.3e-6, Range::positive(),
+               "rbc_stretch: in-plane shear modulus mu0 (N/m); Yeoh law with C10 = mu0/2, C30 = mu0/30 (§4.3)");
+  s.add_double_list("scenario.forces_pN", {0, 20, 40, 60, 80, 100, 120, 140, 160, 180, 200}, Range::non_negative(),
+                    "rbc_stretch: the stretching forces of the sweep (pN), each run to steady state");
+  s.add_double("scenario.patch_um", 2.0, Range::positive(),
+               "rbc_stretch: diameter of the two contact patches at the ends of the diameter along x (um)");
+  s.add_double("scenario.steady_tol", 1e-3, Range::open(0, 1),
+               "rbc_stretch: steady when both diameters change by less than this (relative) over one relaxation time");
+  s.add_double("scenario.max_relaxation_times", 60.0, Range::positive(),
+               "rbc_stretch: give up waiting for a steady state after this many relaxation times per force");
   s.add_double("scenario.k_dt", 0.01, Range::positive(), "shear scenarios: time step in units of 1/k");
   s.add_double("scenario.kt_end", 10.0, Range::positive(), "shear scenarios: end time in units of 1/k");
 

@@ -20,6 +20,7 @@
 #include "immerse/simulation/Scenario.hpp"
 #include "immerse/simulation/ShearPlaneProfile.hpp"
 #include "immerse/simulation/Simulation.hpp"
+#include "immerse/simulation/StretchSweep.hpp"
 
 namespace immerse {
 
@@ -32,12 +33,16 @@ const std::vector<std::string> kStepColumns{"step",         "time",     "dt",   
                                             "gmres_its",    "fluid_solves", "residual", "wall_s"};
 const std::vector<std::string> kMembraneColumns{"volume", "area", "cx", "cy", "cz", "a1", "a2", "a3", "D_xz", "theta"};
 
-std::vector<std::string> diagnostics_columns(std::size_t membranes) {
+bool is_cell_scenario(const io::Config& c) { return c.get<std::string>("scenario.kind") == "rbc_stretch"; }
+
+std::vector<std::string> diagnostics_columns(std::size_t membranes, bool cells) {
   auto cols = kStepColumns;
   for (std::size_t m = 0; m < membranes; ++m) {
     std::string prefix;
     if (membranes > 1) prefix.append("m").append(std::to_string(m)).append("_");
     for (const auto& c : kMembraneColumns) cols.push_back(prefix + c);
+    if (cells)
+      for (const char* c : {"axial_um", "transverse_um"}) cols.push_back(prefix + c);
   }
   return cols;
 }
@@ -57,6 +62,10 @@ std::vector<double> diagnostics_row(const Simulation& sim, const StepRecord& r) 
     const ShearPlaneProfile p = shear_plane_profile(sim.mesh(m), X, g.centroid);
     row.insert(row.end(), {g.volume, g.area, g.centroid.x, g.centroid.y, g.centroid.z, g.semi_axes[0], g.semi_axes[1],
                            g.semi_axes[2], p.D_xz, p.theta});
+    if (is_cell_scenario(sim.config())) {
+      const CellDiameters d = cell_diameters(X);
+      row.insert(row.end(), {d.axial * 1e6, d.transverse * 1e6});
+    }
   }
   return row;
 }
@@ -156,8 +165,13 @@ int run_command(const RunOptions& options, std::ostream& out, std::ostream& err)
   // 1. Everything that can be wrong with the input is found before anything is written.
   const io::ConfigSchema schema = run_schema();
   const io::Config config = apply_scenario(schema.parse_file(options.file, options.sets));
+  const bool sweep_run = is_cell_scenario(config);
+  if (sweep_run && !options.restart.empty())
+    throw InputError("--restart: not available for rbc_stretch force sweeps (restart each force as its own run)");
   Simulation sim(config);
   if (!options.restart.empty()) sim.restore(io::Checkpoint::read(options.restart));
+  std::unique_ptr<StretchSweep> sweep;
+  if (sweep_run) sweep = std::make_unique<StretchSweep>(sim);
   std::filesystem::create_directories(options.out);
   const std::filesystem::path dir = options.out;
 
@@ -168,7 +182,7 @@ int run_command(const RunOptions& options, std::ostream& out, std::ostream& err)
 
   const bool restarted = !options.restart.empty();
   if (restarted) truncate_diagnostics(dir / "diagnostics.csv", sim.step());
-  io::CsvWriter csv(dir / "diagnostics.csv", diagnostics_columns(sim.num_membranes()),
+  io::CsvWriter csv(dir / "diagnostics.csv", diagnostics_columns(sim.num_membranes(), sweep_run),
                     restarted ? io::CsvWriter::Mode::Append : io::CsvWriter::Mode::Create);
   const long fields_every = config.get<int>("output.fields_every");
   int first_frame = 0;
@@ -184,8 +198,10 @@ int run_command(const RunOptions& options, std::ostream& out, std::ostream& err)
       {"checkpoint", config.get<int>("output.checkpoint_every"), false, true,
        [&](const Simulation& s) { s.checkpoint().write(dir / "checkpoint.h5"); }},
   };
-  for (auto& c : callbacks)
-    if (c.at_start) c.act(sim);
+  for (auto& c : callbacks) {
+    if (restarted) c.last_step = sim.step();  // the restart step's row, frame and checkpoint already exist
+    if (c.at_start) c.run(sim, sim.step());
+  }
 
   std::signal(SIGINT, on_signal);
   std::signal(SIGTERM, on_signal);
@@ -193,17 +209,35 @@ int run_command(const RunOptions& options, std::ostream& out, std::ostream& err)
   auto log = [&](const std::string& msg) { out << "\n" << msg << "\n"; };
   int status = 0;
   long done = 0;
+  auto step_once = [&] {
+    last = sim.advance(log);
+    ++done;
+    for (auto& c : callbacks)
+      if (c.due(sim.step())) c.run(sim, sim.step());
+    progress.update(sim, done);
+    if (g_stop_signal) status = 4;
+  };
   try {
-    while (!sim.finished()) {
-      last = sim.advance(log);
-      ++done;
-      for (auto& c : callbacks)
-        if (c.due(sim.step())) c.act(sim);
-      progress.update(sim, done);
-      if (g_stop_signal) {
-        status = 4;
-        break;
+    if (sweep) {
+      io::CsvWriter stretch(dir / "stretch.csv", {"force_pN", "axial_um", "transverse_um"});
+      out << "rbc_stretch: " << sweep->patch_nodes() << " nodes in the two contact patches, relaxation time "
+          << sweep->relaxation_time() << " s\n";
+      for (double F : sweep->forces()) {
+        sim.set_applied_forces(0, sweep->nodal_loads(F));
+        sweep->start(sim);
+        do step_once();
+        while (status == 0 && !sim.finished() && !sweep->steady(sim) && !sweep->timed_out(sim));
+        if (status != 0) break;
+        if (sim.finished()) throw SimulationError("time.end reached before the force sweep finished");
+        if (sweep->timed_out(sim))
+          log("force " + std::to_string(F * 1e12) + " pN: not steady after scenario.max_relaxation_times; recorded anyway");
+        const CellDiameters d = cell_diameters(sim.op().membrane_positions(0));
+        stretch.row({F * 1e12, d.axial * 1e6, d.transverse * 1e6});
+        out << "\nforce " << F * 1e12 << " pN: axial " << d.axial * 1e6 << " um, transverse " << d.transverse * 1e6
+            << " um (t = " << sim.time() << " s)\n";
       }
+    } else {
+      while (status == 0 && !sim.finished()) step_once();
     }
   } catch (const SimulationError& e) {
     progress.finish();
@@ -213,7 +247,7 @@ int run_command(const RunOptions& options, std::ostream& out, std::ostream& err)
   progress.finish();
   // The last state (the last accepted step) is always saved, whatever ended the run.
   for (auto& c : callbacks)
-    if (c.at_end && !(c.due(sim.step()) && status == 0 && done > 0)) c.act(sim);
+    if (c.at_end && c.last_step != sim.step()) c.run(sim, sim.step());
   if (status == 4) err << "immerse: interrupted by signal " << g_stop_signal << " at step " << sim.step() << ", t = "
                        << sim.time() << "; checkpoint written to " << (dir / "checkpoint.h5").string() << "\n";
   std::signal(SIGINT, SIG_DFL);

@@ -27,6 +27,16 @@ double shear_rate(const io::Config& c) {
 
 io::Config apply_scenario(const io::Config& config) {
   const std::string kind = config.get<std::string>("scenario.kind");
+  if (kind == "rbc_stretch") {
+    if (config.count("membrane") != 1) throw InputError("scenario.kind = \"rbc_stretch\": needs exactly one [[membrane]]");
+    const double mu0 = config.get<double>("scenario.mu0");
+    io::Config derived = config;
+    config.schema().apply_overrides(derived, std::vector<std::string>{"membrane[0].shape=\"rbc\"",
+                                                                      "membrane[0].law=\"yeoh\"",
+                                                                      "membrane[0].C10=" + num(mu0 / 2),
+                                                                      "membrane[0].C30=" + num(mu0 / 30)});
+    return derived;
+  }
   if (!is_shear(kind)) return config;
   if (config.count("membrane") != 1) throw InputError("scenario.kind = \"" + kind + "\": needs exactly one [[membrane]]");
   require(config.get<std::string>("boundary.z") == "wall", "boundary.z", "\"wall\" for scenario.kind = \"" + kind + "\"");

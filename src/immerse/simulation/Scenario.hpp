@@ -7,6 +7,9 @@
 //   Re = rho k a^2 / mu,   G = mu k a / E_s  (44),   kappa_B_hat = kappa_B / (a^2 E_s)
 // follow k = Re mu / (rho a^2), E_s = mu k a / G and kappa_B = kappa_B_hat a^2 E_s. The fluid starts in the
 // undisturbed shear flow; time.dt and time.end are read in units of the shear time 1/k (k dt and k t_end).
+//
+// rbc_stretch (§4.3): the biconcave cell of eq. (45) with the Yeoh law (23), C10 = mu0/2 and C30 = mu0/30
+// (small-strain shear modulus mu0, notes), stretched along x (see StretchSweep).
 #include "immerse/io/Config.hpp"
 
 namespace immerse {

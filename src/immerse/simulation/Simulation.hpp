@@ -48,6 +48,9 @@ class Simulation {
   const ElasticMembrane& membrane(std::size_t m) const { return *membranes_[m]; }
   const std::vector<Vec3>& reference(std::size_t m) const { return references_[m]; }
 
+  /// External nodal forces on membrane m (see ImmersedBoundaryOperator::set_applied_forces).
+  void set_applied_forces(std::size_t m, const std::vector<Vec3>& F) { op_->set_applied_forces(m, F); }
+
   /// Everything needed to continue bitwise identically.
   io::Checkpoint checkpoint() const;
   /// Continues from a checkpoint of the same configuration (InputError naming the first differing key otherwise;

@@ -1,0 +1,64 @@
+#include "immerse/simulation/StretchSweep.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "immerse/core/Error.hpp"
+
+namespace immerse {
+
+CellDiameters cell_diameters(const std::vector<Vec3>& X) {
+  double xmin = std::numeric_limits<double>::infinity(), xmax = -xmin, ymin = xmin, ymax = -xmin;
+  for (const auto& p : X) {
+    xmin = std::min(xmin, p.x), xmax = std::max(xmax, p.x);
+    ymin = std::min(ymin, p.y), ymax = std::max(ymax, p.y);
+  }
+  return {xmax - xmin, ymax - ymin};
+}
+
+StretchSweep::StretchSweep(const Simulation& sim) {
+  const auto& c = sim.config();
+  for (double f : c.get<std::vector<double>>("scenario.forces_pN")) forces_.push_back(f * 1e-12);
+  require(!forces_.empty(), "scenario.forces_pN", "a non-empty list of forces");
+  tol_ = c.get<double>("scenario.steady_tol");
+  max_wait_ = c.get<double>("scenario.max_relaxation_times");
+  t_relax_ = c.get<double>("fluid.mu") * c.get<double>("membrane[0].R0") / c.get<double>("scenario.mu0");
+  const auto& ref = sim.reference(0);
+  nodes_ = ref.size();
+  auto lo = std::min_element(ref.begin(), ref.end(), [](const Vec3& a, const Vec3& b) { return a.x < b.x; });
+  auto hi = std::max_element(ref.begin(), ref.end(), [](const Vec3& a, const Vec3& b) { return a.x < b.x; });
+  const double r = 0.5 * c.get<double>("scenario.patch_um") * 1e-6;
+  for (std::size_t i = 0; i < ref.size(); ++i) {
+    if (norm(ref[i] - *lo) <= r) left_.push_back(i);
+    if (norm(ref[i] - *hi) <= r) right_.push_back(i);
+  }
+  if (left_.empty() || right_.empty())
+    throw InputError("scenario.patch_um = " + std::to_string(2e6 * r) + ": the contact patches hold no mesh node");
+}
+
+std::vector<Vec3> StretchSweep::nodal_loads(double F) const {
+  std::vector<Vec3> load(nodes_);
+  for (auto i : left_) load[i] = {-F / double(left_.size()), 0, 0};
+  for (auto i : right_) load[i] = {F / double(right_.size()), 0, 0};
+  return load;
+}
+
+void StretchSweep::start(const Simulation& sim) {
+  t_start_ = t_last_ = sim.time();
+  last_ = cell_diameters(sim.op().membrane_positions(0));
+}
+
+bool StretchSweep::steady(const Simulation& sim) {
+  if (sim.time() - t_last_ < t_relax_) return false;
+  const CellDiameters d = cell_diameters(sim.op().membrane_positions(0));
+  const bool still = std::abs(d.axial - last_.axial) <= tol_ * last_.axial &&
+                     std::abs(d.transverse - last_.transverse) <= tol_ * last_.transverse;
+  last_ = d;
+  t_last_ = sim.time();
+  return still;
+}
+
+bool StretchSweep::timed_out(const Simulation& sim) const { return sim.time() - t_start_ > max_wait_ * t_relax_; }
+
+}  // namespace immerse
