@@ -29,10 +29,10 @@ struct MacGeom {
     wall_upper = p.wall_upper;
   }
 
-  /// Whether loops over this grid are worth spreading over OpenMP threads (below ~32³ cells the fork/join
+  /// Whether loops over this grid are worth spreading over OpenMP threads (below ~40³ cells the fork/join
   /// costs more than the work).
   bool threaded() const { return static_cast<long>(n[0]) * n[1] * n[2] >= kMinCellsForThreads; }
-  static constexpr long kMinCellsForThreads = 32768;
+  static constexpr long kMinCellsForThreads = 65536;
 
   /// First unknown index of velocity component d along axis a (the end is always n[a], exclusive).
   int first(int d, int a) const { return (a == d && !periodic[a]) ? 1 : 0; }

@@ -48,20 +48,29 @@ void NavierStokesSolver::apply_wall_values(FaceField& u) const {
   for (int d = 0; d < 3; ++d) {
     if (grid_.periodic(d)) continue;
     Array3& ud = u[d];
-    const int n = grid_.n(d);
-    for (int k = 0; k < ud.nz(); ++k)
-      for (int j = 0; j < ud.ny(); ++j)
-        for (int i = 0; i < ud.nx(); ++i) {
-          const int q = d == 0 ? i : (d == 1 ? j : k);
-          if (q == 0) ud(i, j, k) = params_.wall_lower[d][d];
-          if (q == n) ud(i, j, k) = params_.wall_upper[d][d];
-        }
+    const int e1 = (d + 1) % 3, e2 = (d + 2) % 3;
+    for (int side = 0; side < 2; ++side) {
+      const double v = side == 0 ? params_.wall_lower[d][d] : params_.wall_upper[d][d];
+      mac::Index q{};
+      q[d] = side == 0 ? 0 : grid_.n(d);
+      for (q[e2] = 0; q[e2] < ud.n(e2); ++q[e2])
+        for (q[e1] = 0; q[e1] < ud.n(e1); ++q[e1]) ud(q[0], q[1], q[2]) = v;
+    }
   }
+}
+
+bool NavierStokesSolver::matches_grid(const FaceField& f) const {
+  for (int d = 0; d < 3; ++d)
+    if (f[d].shape() != grid_.face_shape(d)) return false;
+  return true;
 }
 
 void NavierStokesSolver::step(const FluidState& in, const FaceField& force, double dt, FluidState& out) {
   if (!(std::isfinite(dt) && dt > 0)) require(false, "fluid.dt", dt, "> 0");  // (no strings built when valid)
   if (&in == &out) throw std::invalid_argument("NavierStokesSolver::step: `in` and `out` must be different states");
+  if (!matches_grid(in.u) || !matches_grid(force) || in.p.shape() != grid_.cell_shape() ||
+      (in.step > 0 && !matches_grid(in.adv)))
+    throw std::invalid_argument("NavierStokesSolver::step: state or force does not match the grid");
   ensure_shape(out.u, grid_);
   ensure_shape(out.adv, grid_);
   ensure_shape(out.p, grid_);
@@ -84,7 +93,7 @@ void NavierStokesSolver::step(const FluidState& in, const FaceField& force, doub
       const mac::FaceStencil st = mac::gather(un, g, d, q);
       const double a_now = mac::advection_face(in.u, g, d, q, st);
       adv(i, j, k) = a_now;
-      const double a = w_now * a_now + w_old * adv_old(i, j, k);
+      const double a = first ? a_now : w_now * a_now + w_old * adv_old(i, j, k);
       // (9) with the implicit half of the viscous term on the left; its wall values move to the right.
       const double visc = 0.5 * mu * (mac::laplacian(st, g) + mac::wall_source_face(g, d, q));
       rhs(i, j, k) = un(i, j, k) + dt_rho * (-rho * a - mac::gradient_face(in.p, g, d, q) + visc + f(i, j, k) + fb);

@@ -51,6 +51,8 @@ class NavierStokesSolver {
   Grid grid_;
   FluidParams params_;
   MacGeom geom_;
+  bool matches_grid(const FaceField& f) const;
+
   std::array<std::unique_ptr<FastSolver>, 4> solvers_;
   FaceField ustar_;  // u*, then u^{n+1}
   Array3 div_;       // D u*

@@ -242,7 +242,7 @@ std::vector<Check> taylor_green(bool quick) {
   s.T = 0.2;
   s.dt_per_h = 0.25;
   std::vector<Check> checks;
-  space_study(s, quick ? std::vector<int>{24, 48, 96} : std::vector<int>{32, 64, 128, 256, 512}, checks);
+  space_study(s, quick ? std::vector<int>{24, 48, 96} : std::vector<int>{32, 64, 128, 256}, checks);
   time_study(s, quick ? 32 : 64, quick ? 8 : 16, checks);
   return checks;
 }
@@ -401,7 +401,7 @@ std::vector<Check> duct_poiseuille(bool quick) {
 
   // Time stepping from rest reaches the discrete steady solution (the slowest mode decays like
   // exp(−ν π²/4 (1/a² + 1/b²) t), below 1e-15 at t = 3).
-  const Grid g = grid(ns.back());
+  const Grid g = grid(quick ? 32 : 64);  // ~500 steps; 2000 at N=128 take minutes
   const Array3 us = steady(g);
   NavierStokesSolver solver(g, prm, FftPlanning::Estimate);
   FluidState a = solver.initial_state(), b;
@@ -418,7 +418,7 @@ std::vector<Check> duct_poiseuille(bool quick) {
   }
   for (int d = 1; d < 3; ++d)
     for (double v : a.u[d].values()) diff = std::fmax(diff, std::abs(v));
-  checks.push_back({"time-stepped (t = 3) vs direct discrete steady u, max relative, N=" + std::to_string(ns.back()),
+  checks.push_back({"time-stepped (t = 3) vs direct discrete steady u, max relative, N=" + std::to_string(g.n(2)),
                     diff / umax, "<=", 1e-6});
   checks.push_back({"direct discrete steady vs series, max relative, N=" + std::to_string(ns.back()),
                     em.back() / duct.velocity(0, 0), "<=", 1e-2});
