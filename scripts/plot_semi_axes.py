@@ -4,6 +4,7 @@
 Usage: /usr/bin/python3 scripts/plot_semi_axes.py RUN_DIR [-o PNG] [--membrane I]
 For the oscillating membrane of §4.1 (scenario.kind = "oscillating_membrane") the equilibrium sphere of radius
 (abc)^(1/3) = (0.25 * 0.22 * 0.2)^(1/3) = 0.2224 is drawn dashed. Default PNG: RUN_DIR/semi_axes.png.
+The axes are sorted by length, so when two of them cross the curves swap (a kink), unlike the paper's fixed axes.
 """
 import argparse
 import os
