@@ -2,7 +2,9 @@
 
 #include <unistd.h>
 
+#include <array>
 #include <chrono>
+#include <cmath>
 #include <csignal>
 #include <cstdio>
 #include <fstream>
@@ -47,6 +49,29 @@ std::vector<std::string> diagnostics_columns(std::size_t membranes, bool cells) 
   return cols;
 }
 
+// The principal semi-axes ordered by the coordinate axis their direction is closest to (a1 ~ x, a2 ~ y, a3 ~ z),
+// so that each column follows one axis of the shape in time (Figs. 4-5) instead of swapping when lengths cross.
+std::array<double, 3> semi_axes_along_xyz(const MembraneGeometry& g) {
+  std::array<double, 3> a{};
+  std::array<bool, 3> used{};
+  for (int c = 0; c < 3; ++c) {
+    int best = -1;
+    for (int k = 0; k < 3; ++k)
+      if (!used[k] && (best < 0 || std::abs(g.axes[k][c]) > std::abs(g.axes[best][c]))) best = k;
+    used[best] = true;
+    a[c] = g.semi_axes[best];
+  }
+  return a;
+}
+
+// Inclination of the long axis to the flow: angle in (-pi/2, pi/2] of the longest principal axis in the x-z plane.
+double inclination(const MembraneGeometry& g) {
+  double t = std::atan2(g.axes[0].z, g.axes[0].x);
+  if (t > M_PI / 2) t -= M_PI;
+  if (t <= -M_PI / 2) t += M_PI;
+  return t;
+}
+
 std::vector<double> diagnostics_row(const Simulation& sim, const StepRecord& r) {
   std::vector<double> row{double(r.step),
                           r.time,
@@ -60,8 +85,9 @@ std::vector<double> diagnostics_row(const Simulation& sim, const StepRecord& r) 
     const auto X = sim.op().membrane_positions(m);
     const MembraneGeometry g = measure(sim.mesh(m), X);
     const ShearPlaneProfile p = shear_plane_profile(sim.mesh(m), X, g.centroid);
-    row.insert(row.end(), {g.volume, g.area, g.centroid.x, g.centroid.y, g.centroid.z, g.semi_axes[0], g.semi_axes[1],
-                           g.semi_axes[2], p.D_xz, p.theta});
+    const auto a = semi_axes_along_xyz(g);
+    row.insert(row.end(), {g.volume, g.area, g.centroid.x, g.centroid.y, g.centroid.z, a[0], a[1], a[2], p.D_xz,
+                           inclination(g)});
     if (is_cell_scenario(sim.config())) {
       const CellDiameters d = cell_diameters(X);
       row.insert(row.end(), {d.axial * 1e6, d.transverse * 1e6});
@@ -191,7 +217,7 @@ int run_command(const RunOptions& options, std::ostream& out, std::ostream& err)
   StepRecord last;
 
   std::vector<Callback> callbacks{
-      {"diagnostics", config.get<int>("output.diagnostics_every"), false, true,
+      {"diagnostics", config.get<int>("output.diagnostics_every"), !restarted, true,
        [&](const Simulation& s) { csv.row(diagnostics_row(s, last)); }},
       {"fields", fields_every, !restarted && fields_every > 0, fields_every > 0,
        [&](const Simulation& s) { write_frame(frames, s); }},
@@ -259,8 +285,8 @@ int run_command(const RunOptions& options, std::ostream& out, std::ostream& err)
     const auto g = measure(sim.mesh(m), X);
     const auto p = shear_plane_profile(sim.mesh(m), X, g.centroid);
     out << "membrane[" << m << "]: semi-axes " << g.semi_axes[0] << ", " << g.semi_axes[1] << ", " << g.semi_axes[2]
-        << "  volume " << g.volume << "  Taylor deformation D_xz = " << p.D_xz << "  inclination theta = " << p.theta
-        << " rad\n";
+        << "  volume " << g.volume << "  Taylor deformation D_xz = " << p.D_xz << "  inclination theta = "
+        << inclination(g) << " rad\n";
   }
   return status;
 }
