@@ -177,16 +177,25 @@ int run_command(const RunOptions& options, std::ostream& out, std::ostream& err)
   StepRecord last;
 
   std::vector<Callback> callbacks{
+      // A row needs the record of its step: the step that turned out unstable has none.
       {"diagnostics", config.get<int>("output.diagnostics_every"), false, true,
-       [&](const Simulation& s) { csv.row(diagnostics_row(s, last)); }},
+       [&](const Simulation& s) {
+         if (last.step == s.step()) csv.row(diagnostics_row(s, last));
+       }},
       {"fields", fields_every, !restarted && fields_every > 0, fields_every > 0,
        [&](const Simulation& s) { write_frame(frames, s); }},
       {"checkpoint", config.get<int>("output.checkpoint_every"), false, true,
        [&](const Simulation& s) { s.checkpoint().write(dir / "checkpoint.h5"); }},
   };
-  for (auto& c : callbacks)
-    if (c.at_start) c.act(sim);
+  std::vector<long> acted_at(callbacks.size(), -1);  // the step each callback last ran at
+  auto act = [&](std::size_t i) {
+    callbacks[i].act(sim);
+    acted_at[i] = sim.step();
+  };
+  for (std::size_t i = 0; i < callbacks.size(); ++i)
+    if (callbacks[i].at_start) act(i);
 
+  g_stop_signal = 0;
   std::signal(SIGINT, on_signal);
   std::signal(SIGTERM, on_signal);
   Progress progress(out, config.get<double>("time.end"), config.get<double>("output.log_seconds"));
@@ -197,8 +206,8 @@ int run_command(const RunOptions& options, std::ostream& out, std::ostream& err)
     while (!sim.finished()) {
       last = sim.advance(log);
       ++done;
-      for (auto& c : callbacks)
-        if (c.due(sim.step())) c.act(sim);
+      for (std::size_t i = 0; i < callbacks.size(); ++i)
+        if (callbacks[i].due(sim.step())) act(i);
       progress.update(sim, done);
       if (g_stop_signal) {
         status = 4;
@@ -211,9 +220,9 @@ int run_command(const RunOptions& options, std::ostream& out, std::ostream& err)
     status = 3;
   }
   progress.finish();
-  // The last state (the last accepted step) is always saved, whatever ended the run.
-  for (auto& c : callbacks)
-    if (c.at_end && !(c.due(sim.step()) && status == 0 && done > 0)) c.act(sim);
+  // The last state is always saved, whatever ended the run, once.
+  for (std::size_t i = 0; i < callbacks.size(); ++i)
+    if (callbacks[i].at_end && acted_at[i] != sim.step()) act(i);
   if (status == 4) err << "immerse: interrupted by signal " << g_stop_signal << " at step " << sim.step() << ", t = "
                        << sim.time() << "; checkpoint written to " << (dir / "checkpoint.h5").string() << "\n";
   std::signal(SIGINT, SIG_DFL);
