@@ -217,8 +217,11 @@ int run_command(const RunOptions& options, std::ostream& out, std::ostream& err)
   StepRecord last;
 
   std::vector<Callback> callbacks{
+      // A row needs the record of its step: the step that turned out unstable has none.
       {"diagnostics", config.get<int>("output.diagnostics_every"), !restarted, true,
-       [&](const Simulation& s) { csv.row(diagnostics_row(s, last)); }},
+       [&](const Simulation& s) {
+         if (last.step == s.step()) csv.row(diagnostics_row(s, last));
+       }},
       {"fields", fields_every, !restarted && fields_every > 0, fields_every > 0,
        [&](const Simulation& s) { write_frame(frames, s); }},
       {"checkpoint", config.get<int>("output.checkpoint_every"), false, true,
@@ -229,6 +232,7 @@ int run_command(const RunOptions& options, std::ostream& out, std::ostream& err)
     if (c.at_start) c.run(sim, sim.step());
   }
 
+  g_stop_signal = 0;
   std::signal(SIGINT, on_signal);
   std::signal(SIGTERM, on_signal);
   Progress progress(out, config.get<double>("time.end"), config.get<double>("output.log_seconds"));
@@ -271,7 +275,7 @@ int run_command(const RunOptions& options, std::ostream& out, std::ostream& err)
     status = 3;
   }
   progress.finish();
-  // The last state (the last accepted step) is always saved, whatever ended the run.
+  // The last state is always saved, whatever ended the run (after an instability: the unstable state, for inspection).
   for (auto& c : callbacks)
     if (c.at_end && c.last_step != sim.step()) c.run(sim, sim.step());
   if (status == 4) err << "immerse: interrupted by signal " << g_stop_signal << " at step " << sim.step() << ", t = "

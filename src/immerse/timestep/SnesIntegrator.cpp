@@ -16,11 +16,15 @@ SnesIntegrator::SnesIntegrator(Method method, const SolverSettings& settings) : 
 }
 
 SnesIntegrator::~SnesIntegrator() {
+  destroy();
+  if (options_) PetscOptionsDestroy(&options_);
+}
+
+void SnesIntegrator::destroy() {
   if (snes_) SNESDestroy(&snes_);
   if (J_) MatDestroy(&J_);
   if (x_) VecDestroy(&x_);
   if (r_) VecDestroy(&r_);
-  if (options_) PetscOptionsDestroy(&options_);
 }
 
 void SnesIntegrator::setup(std::size_t n) {
@@ -110,6 +114,9 @@ PetscErrorCode SnesIntegrator::converged(SNES snes, PetscInt it, PetscReal, Pets
 }
 
 StepStats SnesIntegrator::step(CoupledOperator& op, double dt) {
+  // PETSc's L-BFGS keeps its secant pairs from one solve to the next; each step starts afresh from H_0 = I instead,
+  // so that a step depends only on the state a checkpoint holds (bitwise restarts).
+  if (method_ == Method::LimitedMemoryBFGS) destroy();
   if (!snes_) setup(op.size());
   if (op.size() != n_) throw std::logic_error("SnesIntegrator: the number of unknowns changed");
   StepStats stats;

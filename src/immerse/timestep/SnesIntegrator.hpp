@@ -37,6 +37,7 @@ class SnesIntegrator final : public MembraneIntegrator {
 
  private:
   void setup(std::size_t n);
+  void destroy();
   static PetscErrorCode form_function(SNES, Vec x, Vec f, void* ctx);
   static PetscErrorCode converged(SNES, PetscInt it, PetscReal xnorm, PetscReal snorm, PetscReal fnorm,
                                   SNESConvergedReason* reason, void* ctx);

@@ -1,0 +1,128 @@
+// What a finished `immerse run` leaves in its --out folder: config.resolved.toml (re-parses to the configuration
+// that ran), diagnostics.csv (the documented header, one row per step at t = step dt), the ParaView series
+// (fields_*.h5 frames, membranes.xdmf, fluid.xdmf) and checkpoint.h5 (the last step).
+#include <gtest/gtest.h>
+
+#include <sstream>
+
+#include "PetscEnvironment.hpp"
+#include "immerse/io/Checkpoint.hpp"
+#include "immerse/simulation/RunSchema.hpp"
+#include "immerse/simulation/Runner.hpp"
+#include "immerse/simulation/Scenario.hpp"
+#include "test_run_support.hpp"
+
+using namespace immerse;
+using namespace immerse::testing;
+
+namespace {
+
+constexpr int kSteps = 6, kFieldsEvery = 2;
+constexpr double kDt = 0.125;
+
+class RunOutputTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    options_.file = scenario_file("oscillating_membrane_quick.toml");
+    options_.sets = small_membrane_sets(kSteps);
+    options_.sets.push_back("output.fields_every=" + std::to_string(kFieldsEvery));
+    options_.out = dir_ / "out";
+    std::ostringstream err;
+    ASSERT_EQ(run_command(options_, log_, err), 0) << err.str();
+    EXPECT_EQ(err.str(), "");
+  }
+  ScratchDir dir_{"output"};
+  RunOptions options_;
+  std::ostringstream log_;
+};
+
+TEST_F(RunOutputTest, ResolvedConfigurationReparsesToTheConfigurationThatRan) {
+  const io::ConfigSchema schema = run_schema();
+  const io::Config ran = apply_scenario(schema.parse_file(options_.file, options_.sets));
+  const fs::path saved = options_.out / "config.resolved.toml";
+  ASSERT_TRUE(fs::exists(saved));
+  EXPECT_TRUE(schema.parse_file(saved, {}) == ran);
+  EXPECT_NE(log_.str().find(ran.to_toml_string()), std::string::npos) << "the resolved configuration is printed";
+  // The checkpoint carries it too.
+  const auto ck = io::Checkpoint::read(options_.out / "checkpoint.h5");
+  EXPECT_TRUE(schema.parse_string(ck.get_string("config"), "checkpoint") == ran);
+  EXPECT_EQ(ck.get_int("step"), kSteps);
+}
+
+TEST_F(RunOutputTest, DiagnosticsHaveTheDocumentedHeaderAndOneRowPerStep) {
+  const auto rows = read_csv(options_.out / "diagnostics.csv");
+  // Header, the initial state (step 0), then one row per step.
+  ASSERT_EQ(rows.size(), std::size_t(kSteps + 2));
+  EXPECT_EQ(std::stol(rows[1][0]), 0);
+  EXPECT_EQ(std::stod(rows[1][1]), 0.0);
+  std::string header;
+  for (const auto& c : rows[0]) header += (header.empty() ? "" : ",") + c;
+  EXPECT_EQ(header, "step,time,dt,newton_its,gmres_its,fluid_solves,residual,wall_s,volume,area,cx,cy,cz,a1,a2,a3,D_xz,theta");
+  for (int s = 1; s <= kSteps; ++s) {
+    const auto& r = rows[s + 1];
+    ASSERT_EQ(r.size(), rows[0].size());
+    EXPECT_EQ(std::stol(r[0]), s);
+    EXPECT_NEAR(std::stod(r[1]), s * kDt, 1e-12);
+    EXPECT_DOUBLE_EQ(std::stod(r[2]), kDt);
+    EXPECT_GE(std::stol(r[3]), 1) << "jfnk: at least one Newton iteration a step";
+    // The membrane stays near the centre of the box and keeps its volume 4/3 pi abc to the 66-node mesh's
+    // accuracy; its longest semi-axis lies between the stress-free radius and the initial 0.25.
+    EXPECT_NEAR(std::stod(r[10]), 0.5, 1e-3);
+    EXPECT_NEAR(std::stod(r[8]), 4.0 / 3.0 * M_PI * 0.25 * 0.22 * 0.2, 0.1 * 4.0 / 3.0 * M_PI * 0.011);
+    EXPECT_GT(std::stod(r[13]), 0.2);
+    EXPECT_LT(std::stod(r[13]), 0.26);
+  }
+}
+
+TEST_F(RunOutputTest, ParaViewSeriesHasOneFrameEveryFieldsEverySteps) {
+  // Frames at steps 0, 2, 4, 6.
+  const int frames = kSteps / kFieldsEvery + 1;
+  for (int f = 0; f < frames; ++f) {
+    char name[32];
+    std::snprintf(name, sizeof name, "fields_%06d.h5", f);
+    EXPECT_TRUE(fs::exists(options_.out / name)) << name;
+  }
+  EXPECT_FALSE(fs::exists(options_.out / "fields_000004.h5"));
+  for (const char* xdmf : {"membranes.xdmf", "fluid.xdmf"}) {
+    const std::string text = read_text(options_.out / xdmf);
+    ASSERT_FALSE(text.empty()) << xdmf;
+    for (int f = 0; f < frames; ++f) {
+      char name[32];
+      std::snprintf(name, sizeof name, "fields_%06d.h5", f);
+      EXPECT_NE(text.find(name), std::string::npos) << xdmf << " does not reference " << name;
+    }
+  }
+}
+
+TEST(RunOutput, WithoutFieldsNoParaViewFilesAndAPrefixPerMembrane) {
+  // Two membranes side by side: the membrane columns are repeated with prefixes m0_, m1_.
+  ScratchDir dir("output_two");
+  const std::string base = read_text(scenario_file("oscillating_membrane_quick.toml"));
+  const fs::path file = dir / "two.toml";
+  std::ofstream(file) << base << "\n" << base.substr(base.find("[[membrane]]"));
+  RunOptions o;
+  o.file = file;
+  o.sets = small_membrane_sets(2);
+  for (const char* s : {"domain.Lx=2.0", "grid.nx=32", "membrane[0].center=[0.5,0.5,0.5]",
+                        "membrane[1].center=[1.5,0.5,0.5]", "membrane[1].mesh.level=1"})
+    o.sets.push_back(s);
+  o.out = dir / "out";
+  std::ostringstream log, err;
+  ASSERT_EQ(run_command(o, log, err), 0) << err.str();
+  const auto rows = read_csv(o.out / "diagnostics.csv");
+  ASSERT_EQ(rows.size(), 4u);
+  ASSERT_EQ(rows[0].size(), 8u + 2 * 10);
+  EXPECT_EQ(rows[0][8], "m0_volume");
+  EXPECT_EQ(rows[0][18], "m1_volume");
+  EXPECT_EQ(rows[0][27], "m1_theta");
+  // Mirror images about x = 1 in a symmetric box: same volumes, centroids at 0.5 and 1.5.
+  EXPECT_NEAR(std::stod(rows[3][8]), std::stod(rows[3][18]), 1e-12);
+  EXPECT_NEAR(std::stod(rows[3][10]), 0.5, 1e-3);
+  EXPECT_NEAR(std::stod(rows[3][20]), 1.5, 1e-3);
+  EXPECT_FALSE(fs::exists(o.out / "membranes.xdmf"));
+  EXPECT_FALSE(fs::exists(o.out / "fluid.xdmf"));
+  EXPECT_FALSE(fs::exists(o.out / "fields_000000.h5"));
+  EXPECT_TRUE(fs::exists(o.out / "checkpoint.h5"));
+}
+
+}  // namespace

@@ -1,0 +1,42 @@
+// An explicit membrane update past its stability limit (forward Euler, eq. 28, at a large step on the oscillating
+// membrane): `immerse run` stops with status 3 and one message naming the step, the time, the membrane and the
+// quantity that ran away, and still leaves the diagnostics and a checkpoint of where it stopped.
+#include <gtest/gtest.h>
+
+#include <regex>
+
+#include "immerse/io/Checkpoint.hpp"
+#include "test_run_support.hpp"
+
+using namespace immerse;
+using namespace immerse::testing;
+
+namespace {
+
+TEST(RunUnstable, ExplicitSchemePastItsLimitStopsWithStatus3) {
+  ScratchDir dir("unstable");
+  const fs::path out = dir / "out";
+  auto sets = small_membrane_sets(100);
+  sets.insert(sets.end(), {"time.scheme=\"euler\"", "time.dt=0.35", "time.end=35.0", "time.max_speed=1.0"});
+  const auto r = run_immerse(run_args(scenario_file("oscillating_membrane_quick.toml"), out, sets), dir / "run");
+  ASSERT_EQ(r.status, 3) << r.out << r.err;
+
+  // immerse: run stopped: unstable at step 9, t = 3.15: membrane[0] node 8 speed exceeds time.max_speed (runaway) ...
+  const std::regex line(R"(immerse: run stopped: unstable at step (\d+), t = ([0-9.e+-]+): membrane\[0\] node \d+ )"
+                        R"((position is not finite|velocity is not finite|speed exceeds time\.max_speed \(runaway\)))"
+                        R"( \(\|u\| = [^ ]+ m/s, bound 1\)\n)");
+  std::smatch m;
+  ASSERT_TRUE(std::regex_match(r.err, m, line)) << r.err;
+  const long step = std::stol(m[1]);
+  EXPECT_GT(step, 1) << "forward Euler is stable for the first steps";
+  EXPECT_NEAR(std::stod(m[2]), 0.35 * double(step), 1e-9);
+
+  // The diagnostics hold every step before the unstable one, once each; the checkpoint holds the unstable step.
+  const auto rows = read_csv(out / "diagnostics.csv");
+  ASSERT_EQ(rows.size(), std::size_t(step + 1));  // header, steps 0..step-1
+  for (long s = 0; s < step; ++s) EXPECT_EQ(std::stol(rows[s + 1][0]), s);
+  ASSERT_TRUE(fs::exists(out / "checkpoint.h5"));
+  EXPECT_EQ(io::Checkpoint::read(out / "checkpoint.h5").get_int("step"), step);
+}
+
+}  // namespace
