@@ -3,6 +3,7 @@
 // convergence orders, residuals) and compares each with what the method must achieve.
 // `immerse verify <name> [--quick]` runs one; the test suite runs every quick form.
 #include <functional>
+#include <ostream>
 #include <string>
 #include <vector>
 
@@ -22,6 +23,9 @@ struct Study {
   std::string description;  ///< one line
   std::function<std::vector<Check>(bool quick)> run;
 };
+
+/// GoogleTest prints a study parameter by its name.
+inline void PrintTo(const Study& s, std::ostream* os) { *os << s.name; }
 
 /// Every study of the program, in the order `immerse verify` lists them.
 std::vector<Study> all_studies();
