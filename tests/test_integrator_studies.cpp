@@ -13,4 +13,5 @@ class IntegratorStudy : public ::testing::TestWithParam<std::string> {};
 TEST_P(IntegratorStudy, QuickFormPasses) { EXPECT_TRUE(run_study(find_study(GetParam()), true, std::cout)); }
 
 INSTANTIATE_TEST_SUITE_P(Studies, IntegratorStudy,
-                         ::testing::Values("oscillating_time_order", "oscillating_stability", "quasi_newton_agreement"));
+                         ::testing::Values("oscillating_time_order", "oscillating_stability", "theta_ringing",
+                                           "quasi_newton_agreement"));
