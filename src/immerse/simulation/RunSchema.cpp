@@ -27,7 +27,7 @@ ConfigSchema membrane_schema() {
   m.add_double("rotation_angle", 0.0, Range::closed(-7, 7), "angle of the rigid rotation (rad)");
   m.add_string("mesh.family", "icosahedral", {"icosahedral", "octahedral", "file"},
                "subdivided icosahedron (10*4^(l+1)+2 nodes) or octahedron (4*4^(l+1)+2 nodes) mapped onto the shape, "
-               "or a Gmsh file (mesh.file, 6- or 3-node triangles, used as is)");
+               "or a Gmsh file (mesh.file, 6- or 3-node triangles: the initial shape itself, placed by center and rotation)");
   m.add_int("mesh.level", 3, Range::closed(0, 7), "subdivision level (icosahedral 4: 10,242 nodes; octahedral 5: 16,386)");
   m.add_string("mesh.file", "", {}, "Gmsh .msh file when mesh.family = \"file\"");
   m.add_string("law", "neo_hookean", {"neo_hookean", "yeoh", "skalak"}, "strain energy: eq. (22), (23) or (24)");

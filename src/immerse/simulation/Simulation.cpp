@@ -113,22 +113,26 @@ void Simulation::build_membranes() {
       const std::string family = m.get<std::string>("mesh.family");
       const int level = m.get<int>("mesh.level");
       Mesh mesh;
-      std::vector<Vec3> unit;
+      std::vector<Vec3> initial, reference;
       if (family == "file") {
+        // A user's mesh is the initial shape itself, placed by center and rotation; its reference is the same
+        // shape, or the reference sphere over the directions of its nodes (for star-shaped meshes).
         const std::string file = m.get<std::string>("mesh.file");
         require(!file.empty(), "mesh.file", "a Gmsh file name when mesh.family = \"file\"");
         mesh = read_gmsh(file);
-        unit = mesh.nodes;  // a user's mesh is used as it is: shape keys place it (sphere radius scales it)
-        for (auto& p : unit) p = normalized(p);
+        const RigidTransform place = shape_of(m, false).placement;
+        for (const auto& p : mesh.nodes) initial.push_back(place.rotation * p + place.translation);
+        if (m.get<std::string>("reference") == "sphere") {
+          std::vector<Vec3> unit;
+          for (const auto& p : mesh.nodes) unit.push_back(normalized(p));
+          reference = map_sphere(shape_of(m, true), unit);
+        } else {
+          reference = initial;
+        }
       } else {
         mesh = family == "icosahedral" ? icosahedral_sphere(level) : octahedral_sphere(level);
-        unit = mesh.nodes;
-      }
-      auto initial = map_sphere(shape_of(m, false), unit);
-      auto reference = map_sphere(shape_of(m, true), unit);
-      if (m.get<std::string>("reference") == "sphere") {
-        const Vec3 c = m.get<Vec3>("center");
-        for (auto& p : reference) p += c - shape_of(m, true).placement.translation;
+        initial = map_sphere(shape_of(m, false), mesh.nodes);
+        reference = map_sphere(shape_of(m, true), mesh.nodes);
       }
       mesh.nodes = initial;
       validate_closed_mesh(mesh, name);
