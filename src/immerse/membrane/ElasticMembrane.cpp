@@ -49,7 +49,7 @@ Vec3 chord_normal(const Nodes& x) { return cross(x[1] - x[0], x[2] - x[0]); }
 
 void throw_if_bad(int bad) {
   if (bad != INT_MAX)
-    throw SimulationError("membrane element " + std::to_string(bad) +
+    throw SimulationError("element " + std::to_string(bad) +
                           ": Jacobian <= 0 or not finite (element inverted or degenerate)");
 }
 

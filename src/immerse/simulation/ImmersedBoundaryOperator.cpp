@@ -18,8 +18,7 @@ ImmersedBoundaryOperator::ImmersedBoundaryOperator(NavierStokesSolver& fluid, IB
       membranes_(std::move(membranes)),
       committed_(std::move(fluid_state)),
       force_start_(fluid.grid()),
-      force_(fluid.grid()),
-      scratch_(fluid.grid()) {
+      force_(fluid.grid()) {
   if (X0.size() != membranes_.size()) throw std::logic_error("ImmersedBoundaryOperator: one position array per membrane");
   for (std::size_t m = 0; m < membranes_.size(); ++m) {
     if (X0[m].size() != membranes_[m]->num_nodes())
@@ -46,7 +45,7 @@ void ImmersedBoundaryOperator::membrane_force_density(std::span<const Vec3> X, F
       check_nodes_in_domain(fluid_.grid(), Xm_[m]);
       membranes_[m]->compute_force(Xm_[m], Fm_[m]);
     } catch (const SimulationError& e) {
-      throw SimulationError("membrane " + std::to_string(m) + ": " + e.what());
+      throw SimulationError("membrane[" + std::to_string(m) + "] " + e.what());
     }
     for (std::size_t i = 0; i < Fm_[m].size(); ++i) F_[offset_[m] + i] = Fm_[m][i] + applied_[offset_[m] + i];
   }

@@ -64,7 +64,7 @@ class ImmersedBoundaryOperator final : public CoupledOperator {
   std::vector<Vec3> X_, U_;          ///< committed positions and node velocities
   FluidState committed_, trial_;
   FaceField force_start_;  ///< S(X^n) f(X^n)
-  FaceField force_, scratch_;
+  FaceField force_;
   std::vector<Vec3> F_;                                 ///< nodal forces, all membranes
   std::vector<Vec3> applied_;                           ///< external nodal forces, all membranes
   std::vector<std::vector<Vec3>> Xm_, Fm_;              ///< per-membrane scratch for compute_force
