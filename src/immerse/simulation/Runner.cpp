@@ -148,6 +148,8 @@ class Progress {
     std::ostringstream s;
     s << std::setprecision(4) << "t = " << sim.time() << " / " << end_ << "  step " << sim.step() << "  "
       << rate << " steps/s  ETA " << std::fixed << std::setprecision(0) << eta << " s";
+    const double wall = sim.op().min_wall_distance();
+    if (std::isfinite(wall)) s << std::scientific << std::setprecision(3) << "  closest wall approach " << wall;
     if (tty_) {
       const int width = 30, done = static_cast<int>(frac * width);
       out_ << "\r[" << std::string(done, '#') << std::string(width - done, '.') << "] " << s.str() << "   " << std::flush;
@@ -283,7 +285,11 @@ int run_command(const RunOptions& options, std::ostream& out, std::ostream& err)
   std::signal(SIGINT, SIG_DFL);
   std::signal(SIGTERM, SIG_DFL);
 
-  out << "done: " << sim.step() << " steps, t = " << sim.time() << "\n";
+  out << "done: " << sim.step() << " steps, t = " << sim.time();
+  if (status == 0)
+    if (const double wall = sim.op().min_wall_distance(); std::isfinite(wall))
+      out << ", closest approach of a node to a wall " << wall;
+  out << "\n";
   for (std::size_t m = 0; m < sim.num_membranes(); ++m) {
     const auto X = sim.op().membrane_positions(m);
     const auto g = measure(sim.mesh(m), X);
