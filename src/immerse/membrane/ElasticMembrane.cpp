@@ -146,6 +146,30 @@ void ElasticMembrane::check_size(const std::vector<Vec3>& X) const {
 
 namespace {
 
+/// The surface derivative of a nodal field g at every element node, as eqs. (40) and (41) need it:
+/// out[6e + k] = op(frame at node k of element e, dg/dxi, dg/deta), with g interpolated by the shape functions (38).
+template <class T, class Op>
+void element_node_derivative(const std::vector<std::array<int, 6>>& elements, const std::vector<Vec3>& X,
+                             const std::vector<T>& g, Op op, std::vector<decltype(op(Frame{}, T{}, T{}))>& out) {
+  const int E = static_cast<int>(elements.size());
+  out.resize(6 * static_cast<std::size_t>(E));
+#pragma omp parallel for schedule(static)
+  for (int e = 0; e < E; ++e) {
+    const auto& el = elements[e];
+    const Nodes x = element_nodes(el, X);
+    for (int k = 0; k < 6; ++k) {
+      const tri6::Shape& s = kNodeShape[k];
+      const Frame f = membrane_k::frame(membrane_k::tangents(x, s));
+      T dg_dxi{}, dg_deta{};
+      for (int j = 0; j < 6; ++j) {
+        dg_dxi += s.dxi[j] * g[el[j]];
+        dg_deta += s.deta[j] * g[el[j]];
+      }
+      out[6 * e + k] = op(f, dg_dxi, dg_deta);
+    }
+  }
+}
+
 /// node[i] = mean over the element-node slots of node i (fixed order).
 template <class T>
 void average(const std::vector<int>& start, const std::vector<int>& inc, const std::vector<T>& en,
@@ -211,30 +235,13 @@ void ElasticMembrane::element_node_pass(const std::vector<Vec3>& X, bool with_te
 
 // Curvature tensor (40) at element nodes from the interpolated nodal normals, averaged at the nodes.
 void ElasticMembrane::curvature_pass(const std::vector<Vec3>& X, Work& w) const {
-  const int E = static_cast<int>(num_elements());
-  w.en_kappa.resize(6 * E);
-#pragma omp parallel for schedule(static)
-  for (int e = 0; e < E; ++e) {
-    const auto& el = elements_[e];
-    const Nodes x = element_nodes(el, X);
-    for (int k = 0; k < 6; ++k) {
-      const tri6::Shape& s = kNodeShape[k];
-      const Frame f = membrane_k::frame(membrane_k::tangents(x, s));
-      Vec3 dn_dxi, dn_deta;
-      for (int j = 0; j < 6; ++j) {
-        dn_dxi += s.dxi[j] * w.node_n[el[j]];
-        dn_deta += s.deta[j] * w.node_n[el[j]];
-      }
-      w.en_kappa[6 * e + k] = membrane_k::curvature(f, dn_dxi, dn_deta);
-    }
-  }
+  element_node_derivative(elements_, X, w.node_n, membrane_k::curvature, w.en_kappa);
   average(inc_start_, inc_, w.en_kappa, w.node_kappa);
 }
 
 // Bending: kappa (40) averaged at nodes; m (25) at nodes; (P.grad).m = tr K (41) at element nodes from the
 // interpolated nodal moments, averaged; q (27) at nodes.
 void ElasticMembrane::bending_passes(const std::vector<Vec3>& X, Work& w) const {
-  const int E = static_cast<int>(num_elements());
   const int N = static_cast<int>(num_nodes());
   curvature_pass(X, w);
 
@@ -243,22 +250,7 @@ void ElasticMembrane::bending_passes(const std::vector<Vec3>& X, Work& w) const 
   for (int i = 0; i < N; ++i)
     w.node_m[i] = bending_.kappa_B * (w.node_kappa[i] - kappa_ref_[i] * projector(w.node_n[i]));
 
-  w.en_div.resize(6 * E);
-#pragma omp parallel for schedule(static)
-  for (int e = 0; e < E; ++e) {
-    const auto& el = elements_[e];
-    const Nodes x = element_nodes(el, X);
-    for (int k = 0; k < 6; ++k) {
-      const tri6::Shape& s = kNodeShape[k];
-      const Frame f = membrane_k::frame(membrane_k::tangents(x, s));
-      Mat3 dm_dxi, dm_deta;
-      for (int j = 0; j < 6; ++j) {
-        dm_dxi += s.dxi[j] * w.node_m[el[j]];
-        dm_deta += s.deta[j] * w.node_m[el[j]];
-      }
-      w.en_div[6 * e + k] = membrane_k::moment_divergence(f, dm_dxi, dm_deta);
-    }
-  }
+  element_node_derivative(elements_, X, w.node_m, membrane_k::moment_divergence, w.en_div);
   average(inc_start_, inc_, w.en_div, w.node_q);
 #pragma omp parallel for schedule(static)
   for (int i = 0; i < N; ++i) w.node_q[i] = w.node_q[i] * projector(w.node_n[i]);
