@@ -1,5 +1,6 @@
 #!/usr/bin/python3
-"""Figs. 4-5 of the paper: the principal semi-axes a1 >= a2 >= a3 of the membrane's equivalent ellipsoid vs time.
+"""Figs. 4-5 of the paper: the principal semi-axes a1, a2, a3 of the membrane's equivalent ellipsoid vs time
+(a1, a2, a3: the principal axes nearest to x, y and z, so each curve follows one axis of the shape).
 
 Usage: /usr/bin/python3 scripts/plot_semi_axes.py RUN_DIR [-o PNG] [--membrane I]
 For the oscillating membrane of §4.1 (scenario.kind = "oscillating_membrane") the equilibrium sphere of radius
@@ -29,8 +30,8 @@ def main():
     length_unit, time_unit = (" / L", "") if oscillating else (" (m)", " (s)")
 
     fig, ax = plt.subplots(figsize=(6.4, 4.0))
-    for name, style in (("a1", "-"), ("a2", "--"), ("a3", "-.")):
-        ax.plot(t, pc.membrane_column(diag, name, args.membrane), style, lw=1.5, label=name)
+    for name, axis, style in (("a1", "x", "-"), ("a2", "y", "--"), ("a3", "z", "-.")):
+        ax.plot(t, pc.membrane_column(diag, name, args.membrane), style, lw=1.5, label=f"{name} (along {axis})")
     summary = ""
     if oscillating:
         a, b, c = cfg["membrane"][args.membrane]["semi_axes"]
