@@ -5,6 +5,7 @@
 #include <cstring>
 
 #include "immerse/io/Checkpoint.hpp"
+#include "immerse/membrane/MeshGenerator.hpp"
 #include "test_run_support.hpp"
 
 using namespace immerse;
@@ -103,3 +104,44 @@ INSTANTIATE_TEST_SUITE_P(
     [](const auto& p) { return p.param.name; });
 
 }  // namespace
+
+// A user's mesh file that changed between a run and its restart: the reference state rebuilt from the configuration
+// is not the one in the checkpoint, and the restart is refused.
+TEST(BadInputRestart, ChangedMeshFileIsRefused) {
+  const fs::path dir = fs::temp_directory_path() / ("immerse_changed_mesh_" + std::to_string(getpid()));
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  const Mesh sphere = octahedral_sphere(1);
+  auto write_msh = [&](double radius) {
+    std::ofstream f(dir / "cell.msh");
+    f.precision(17);
+    f << "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n$Nodes\n" << sphere.nodes.size() << "\n";
+    for (std::size_t i = 0; i < sphere.nodes.size(); ++i)
+      f << i + 1 << " " << radius * sphere.nodes[i].x << " " << radius * sphere.nodes[i].y << " "
+        << radius * sphere.nodes[i].z << "\n";
+    f << "$EndNodes\n$Elements\n" << sphere.elements.size() << "\n";
+    for (std::size_t e = 0; e < sphere.elements.size(); ++e) {
+      f << e + 1 << " 9 2 0 1";
+      for (int n : sphere.elements[e]) f << " " << n + 1;
+      f << "\n";
+    }
+    f << "$EndElements\n";
+  };
+  auto sets = [&](int steps) {
+    auto s = small_membrane_sets(steps);
+    s.insert(s.end(), {"membrane[0].mesh.family=\"file\"", "membrane[0].mesh.file=\"" + (dir / "cell.msh").string() + "\"",
+                       "membrane[0].reference=\"initial\""});
+    return s;
+  };
+  write_msh(0.2);
+  const auto first = run_immerse(run_args(scenario_file("oscillating_membrane_quick.toml"), dir / "a", sets(1)),
+                                 dir / "first");
+  ASSERT_EQ(first.status, 0) << first.err;
+  write_msh(0.21);
+  const auto again = run_immerse(run_args(scenario_file("oscillating_membrane_quick.toml"), dir / "a", sets(2),
+                                          dir / "a" / "checkpoint.h5"),
+                                 dir / "again");
+  EXPECT_EQ(again.status, 2) << again.err;
+  EXPECT_NE(again.err.find("the reference state of membrane[0] differs"), std::string::npos) << again.err;
+  fs::remove_all(dir);
+}

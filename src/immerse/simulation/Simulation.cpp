@@ -312,6 +312,10 @@ void Simulation::restore(const io::Checkpoint& ck) {
   f.time = ck.get_double("fluid.time");
   std::vector<std::vector<Vec3>> X(num_membranes());
   for (std::size_t m = 0; m < num_membranes(); ++m) {
+    const auto& R = references_[m];
+    if (ck.array(membrane_name(m) + ".reference") != std::vector<double>(&R[0].x, &R[0].x + 3 * R.size()))
+      throw InputError("checkpoint: the reference state of " + membrane_name(m) +
+                       " differs from the one this configuration builds (was its mesh file changed?)");
     const auto& a3 = ck.array(membrane_name(m) + ".positions");
     X[m].resize(a3.size() / 3);
     for (std::size_t i = 0; i < X[m].size(); ++i) X[m][i] = {a3[3 * i], a3[3 * i + 1], a3[3 * i + 2]};
