@@ -91,6 +91,8 @@ INSTANTIATE_TEST_SUITE_P(
         BadInput{"overlapping_membranes", "two_membranes.toml", {"membrane[1].mesh.level=1"}, "",
                  "membrane[1] overlaps membrane[0]"},
         BadInput{"unknown_scheme", "", {"time.scheme=\"rk4\""}, "", "time.scheme = \"rk4\": must be one of"},
+        BadInput{"dense_bfgs_on_a_large_mesh", "", {"time.scheme=\"bfgs\"", "membrane[0].mesh.level=4"}, "",
+                 "is limited to 12000 unknowns and this run has 12294"},
         BadInput{"missing_config", "no_such_file.toml", {}, "", "no_such_file.toml: cannot read: No such file or directory"},
         BadInput{"config_syntax_error", "syntax_error.toml", {}, "", "syntax_error.toml:2"},
         BadInput{"missing_mesh_file", "", {"membrane[0].mesh.family=\"file\"", "membrane[0].mesh.file=\"no_such.msh\""},

@@ -13,6 +13,7 @@
 #include "immerse/membrane/Shape.hpp"
 #include "immerse/membrane/Skalak.hpp"
 #include "immerse/membrane/Yeoh.hpp"
+#include "immerse/timestep/DenseBfgs.hpp"
 
 namespace immerse {
 
@@ -103,6 +104,10 @@ Simulation::Simulation(const io::Config& config)
   for (auto& m : membranes_) ms.push_back(m.get());
   op_ = std::make_unique<ImmersedBoundaryOperator>(fluid_, coupler_, ms, initial_, initial_fluid_state());
   integrator_ = make_integrator(config.get<std::string>("time.scheme"), make_settings(config));
+  if (integrator_->name() == "bfgs" && op_->size() > DenseBfgs::max_unknowns)
+    throw InputError("time.scheme = \"bfgs\": the dense quasi-Newton matrix of eq. (35) is limited to " +
+                     std::to_string(DenseBfgs::max_unknowns) + " unknowns and this run has " +
+                     std::to_string(op_->size()) + " (use \"lbfgs\" or \"jfnk\")");
 }
 
 void Simulation::build_membranes() {
