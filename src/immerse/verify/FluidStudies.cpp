@@ -56,6 +56,13 @@ struct ExactFlow {
   std::function<ForceFn(const Grid&)> force;  // empty: no force
 };
 
+/// The exact velocity and pressure of an analytic solution (any type with velocity(x, t) and pressure(x, t)).
+template <class Solution>
+ExactFlow exact_flow(const Solution& sol, std::function<ForceFn(const Grid&)> force = {}) {
+  return {[sol](const Vec3& x, double t) { return sol.velocity(x, t); },
+          [sol](const Vec3& x, double t) { return sol.pressure(x, t); }, std::move(force)};
+}
+
 struct RunResult {
   FluidState last;
   Array3 p_before_last;  // p one step before the end
@@ -236,9 +243,7 @@ std::vector<Check> taylor_green(bool quick) {
   s.grid = [](int n) { return Grid({n, n, 2}, {1.0, 1.0, 2.0 / n}, {P, P, P}); };
   s.params.rho = tg.rho;
   s.params.mu = tg.mu;
-  s.flow = {[tg](const Vec3& x, double t) { return tg.velocity(x, t); },
-            [tg](const Vec3& x, double t) { return tg.pressure(x, t); },
-            {}};
+  s.flow = exact_flow(tg);
   s.T = 0.2;
   s.dt_per_h = 0.25;
   std::vector<Check> checks;
@@ -255,9 +260,7 @@ std::vector<Check> abc_flow(bool quick) {
   };
   s.params.rho = abc.rho;
   s.params.mu = abc.mu;
-  s.flow = {[abc](const Vec3& x, double t) { return abc.velocity(x, t); },
-            [abc](const Vec3& x, double t) { return abc.pressure(x, t); },
-            {}};
+  s.flow = exact_flow(abc);
   s.T = 0.4;
   s.dt_per_h = 0.25;
   std::vector<Check> checks;
@@ -272,9 +275,7 @@ std::vector<Check> closed_box_mms(bool quick) {
   s.grid = [](int n) { return Grid({n, n, n}, {1.0, 1.0, 1.0}, {W, W, W}); };
   s.params.rho = mms.rho;
   s.params.mu = mms.mu;
-  s.flow = {[mms](const Vec3& x, double t) { return mms.velocity(x, t); },
-            [mms](const Vec3& x, double t) { return mms.pressure(x, t); },
-            [mms](const Grid& g) -> ForceFn {
+  s.flow = exact_flow(mms, [mms](const Grid& g) -> ForceFn {
               auto parts = std::make_shared<std::array<FaceField, 4>>();
               for (auto& f : *parts) f = FaceField(g);
               for (int d = 0; d < 3; ++d) {
@@ -295,7 +296,7 @@ std::vector<Check> closed_box_mms(bool quick) {
                     f[d][n] = v;
                   }
               };
-            }};
+            });
   s.T = 0.25;
   s.dt_per_h = 0.2;
   std::vector<Check> checks;
