@@ -67,18 +67,19 @@ class ElasticMembrane {
   std::size_t num_nodes() const { return reference_.size(); }
   std::size_t num_elements() const { return elements_.size(); }
   ForceMethod method() const { return method_; }
-  /// Bytes held by this object (reference data, incidence) plus the workspace one compute_force allocates.
+  /// Bytes held by this object (reference data, incidence) plus the workspace compute_force keeps per calling
+  /// thread.
   std::size_t memory_bytes() const;
 
  private:
   struct Work;
+  static Work& workspace();  ///< compute_force's scratch data, one per calling thread
   void check_size(const std::vector<Vec3>& X) const;
-  void element_node_pass(const std::vector<Vec3>& X, bool with_tension, Work& w) const;
-  void curvature_pass(const std::vector<Vec3>& X, Work& w) const;
+  void node_pass(const std::vector<Vec3>& X, bool with_tension, Work& w) const;
+  void curvature_pass(const std::vector<Vec3>& X, bool moments, Work& w) const;
   void bending_passes(const std::vector<Vec3>& X, Work& w) const;
   void contour_forces(const std::vector<Vec3>& X, bool with_tension, bool with_bending, Work& w) const;
   void energy_forces(const std::vector<Vec3>& X, Work& w) const;
-  void gather(const std::vector<Vec3>& en, std::vector<Vec3>& node) const;
   std::vector<double> reference_mean_curvature() const;
 
   std::vector<std::array<int, 6>> elements_;

@@ -18,7 +18,7 @@ struct Yeoh {
     require(C30 >= 0, "membrane.law.C30", C30, ">= 0");
   }
 
-  EnergyDensity operator()(double A1, double A2) const {
+  [[gnu::always_inline]] EnergyDensity operator()(double A1, double A2) const {
     const double e = std::exp(-2 * A1);
     const double I = 2 * A2 + e - 1;
     const double dW_dI = C10 + 3 * C30 * I * I;
