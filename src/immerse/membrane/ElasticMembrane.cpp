@@ -147,7 +147,8 @@ Mat3 projector(const Vec3& n) { return Mat3::identity() - Mat3::outer(n, n); }
 struct ElasticMembrane::Work {
   std::vector<membrane_k::SymTensor> node_tau;  // tension (18) averaged at nodes
   std::vector<Vec3> node_n;                     // unit normal at nodes
-  std::vector<Mat3> node_kappa;                 // curvature (40) averaged at nodes (reference curvature only)
+  std::vector<Vec3> node_nfit;                  // fitted unit normal N at nodes (bending)
+  std::vector<Mat3> node_kappa;                 // fitted curvature tensor (40) at nodes (bending)
   std::vector<Mat3> node_m;                     // moments (25)
   std::vector<Vec3> node_q;                     // transverse shear tension (27)
   std::vector<Vec3> el_force;                   // F_e of eq. (42) per element
@@ -204,8 +205,9 @@ ElasticMembrane::ElasticMembrane(const Mesh& mesh, std::vector<Vec3> reference, 
       store_metric(ref_quad_, 6 * e + k, membrane_k::ref_metric(tq));
     }
   }
-  kappa_ref_ = bending_.reference == ReferenceCurvature::RestShape ? reference_mean_curvature()
-                                                                   : std::vector<double>(N, 0.0);
+  if (bending_.kappa_B > 0) fit_.emplace(mesh, reference_);
+  kappa_ref_ = fit_ && bending_.reference == ReferenceCurvature::RestShape ? reference_mean_curvature()
+                                                                          : std::vector<double>(N, 0.0);
 }
 
 void ElasticMembrane::check_size(const std::vector<Vec3>& X) const {
@@ -257,35 +259,22 @@ void ElasticMembrane::node_pass(const std::vector<Vec3>& X, bool with_tension, W
   throw_if_bad(bad);
 }
 
-// Curvature tensor (40) at element nodes from the interpolated nodal normals, averaged at the nodes; then either
-// stored (node_kappa) or turned into the moments (25), m = kappa_B (kappa - kappa_m^R P) (node_m).
-void ElasticMembrane::curvature_pass(const std::vector<Vec3>& X, bool moments, Work& w) const {
+// Bending moments (25), m = kappa_B (kappa - kappa_m^R P), P = I - N N, with the nodal normal N and curvature
+// tensor kappa (40) from the local quartic fit (CurvatureFit).
+void ElasticMembrane::moment_pass(const std::vector<Vec3>& X, Work& w) const {
   const int N = static_cast<int>(num_nodes());
-  (moments ? w.node_m : w.node_kappa).resize(N);
+  fit_->compute(X, w.node_nfit, w.node_kappa);
+  w.node_m.resize(N);
 #pragma omp parallel for schedule(static)
-  for (int i = 0; i < N; ++i) {
-    Mat3 kappa;
-    for (int j = inc_start_[i]; j < inc_start_[i + 1]; ++j) {
-      const int slot = inc_[j], e = slot / 6, k = slot % 6;
-      const auto& el = elements_[e];
-      const Frame f = membrane_k::frame(slot_tangents(el, k, X));
-      Vec3 dn_dxi, dn_deta;
-      node_derivatives(k, [&](int m) { return w.node_n[el[m]]; }, dn_dxi, dn_deta);
-      kappa += membrane_k::curvature(f, dn_dxi, dn_deta);
-    }
-    kappa *= 1.0 / (inc_start_[i + 1] - inc_start_[i]);
-    if (moments)
-      w.node_m[i] = bending_.kappa_B * (kappa - kappa_ref_[i] * projector(w.node_n[i]));
-    else
-      w.node_kappa[i] = kappa;
-  }
+  for (int i = 0; i < N; ++i)
+    w.node_m[i] = bending_.kappa_B * (w.node_kappa[i] - kappa_ref_[i] * projector(w.node_nfit[i]));
 }
 
-// Bending: moments (25) from the curvature (40); (P.grad).m = tr K (41) at element nodes from the interpolated
-// nodal moments, averaged; q (27) at nodes.
+// Bending: moments (25) at the nodes; (P.grad).m = tr K (41) at element nodes from the interpolated nodal
+// moments, averaged; q (27) at nodes with the fitted normal's projector.
 void ElasticMembrane::bending_passes(const std::vector<Vec3>& X, Work& w) const {
   const int N = static_cast<int>(num_nodes());
-  curvature_pass(X, true, w);
+  moment_pass(X, w);
   w.node_q.resize(N);
 #pragma omp parallel for schedule(static)
   for (int i = 0; i < N; ++i) {
@@ -299,7 +288,7 @@ void ElasticMembrane::bending_passes(const std::vector<Vec3>& X, Work& w) const 
       div += membrane_k::moment_divergence(f, dm_dxi, dm_deta);
     }
     div *= 1.0 / (inc_start_[i + 1] - inc_start_[i]);
-    w.node_q[i] = div * projector(w.node_n[i]);
+    w.node_q[i] = div * projector(w.node_nfit[i]);
   }
 }
 
@@ -499,11 +488,11 @@ std::vector<Vec3> ElasticMembrane::node_normal(const std::vector<Vec3>& X) const
 
 // kappa_m^R = tr(kappa)/2 of the reference shape, kappa from (40) averaged at the nodes.
 std::vector<double> ElasticMembrane::reference_mean_curvature() const {
-  Work w;
-  node_pass(reference_, false, w);
-  curvature_pass(reference_, false, w);
+  std::vector<Vec3> normal;
+  std::vector<Mat3> kappa;
+  fit_->compute(reference_, normal, kappa);
   std::vector<double> c(num_nodes());
-  for (std::size_t i = 0; i < c.size(); ++i) c[i] = 0.5 * trace(w.node_kappa[i]);
+  for (std::size_t i = 0; i < c.size(); ++i) c[i] = 0.5 * trace(kappa[i]);
   return c;
 }
 

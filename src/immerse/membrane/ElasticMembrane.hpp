@@ -14,9 +14,11 @@
 // See docs/membrane-bending.md for the derivations, the lumping rule and the one deviation from the paper
 // (element-node tensions, not deformation gradients, are averaged at nodes).
 #include <cstddef>
+#include <optional>
 #include <vector>
 
 #include "immerse/core/Vec3.hpp"
+#include "immerse/membrane/CurvatureFit.hpp"
 #include "immerse/membrane/MaterialLaw.hpp"
 #include "immerse/membrane/Mesh.hpp"
 
@@ -76,7 +78,7 @@ class ElasticMembrane {
   static Work& workspace();  ///< compute_force's scratch data, one per calling thread
   void check_size(const std::vector<Vec3>& X) const;
   void node_pass(const std::vector<Vec3>& X, bool with_tension, Work& w) const;
-  void curvature_pass(const std::vector<Vec3>& X, bool moments, Work& w) const;
+  void moment_pass(const std::vector<Vec3>& X, Work& w) const;
   void bending_passes(const std::vector<Vec3>& X, Work& w) const;
   void contour_forces(const std::vector<Vec3>& X, bool with_tension, bool with_bending, Work& w) const;
   void energy_forces(const std::vector<Vec3>& X, Work& w) const;
@@ -92,6 +94,7 @@ class ElasticMembrane {
   std::vector<double> ref_node_;  ///< per element node: Gbar^{xx}, Gbar^{xe}, Gbar^{ee}, Jbar (4 doubles)
   std::vector<double> ref_quad_;  ///< per quadrature point: Gbar^{xx}, Gbar^{xe}, Gbar^{ee}, Jbar w
   std::vector<double> kappa_ref_;
+  std::optional<CurvatureFit> fit_;  ///< nodal normal and curvature for the bending moments (kappa_B > 0)
 };
 
 }  // namespace immerse
