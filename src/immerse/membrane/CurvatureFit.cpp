@@ -6,6 +6,7 @@
 #include <string>
 
 #include "immerse/core/Error.hpp"
+#include "immerse/membrane/BalancedRange.hpp"
 
 namespace immerse {
 
@@ -119,8 +120,8 @@ void CurvatureFit::compute(const std::vector<Vec3>& X, std::vector<Vec3>& normal
   const int N = static_cast<int>(start_.size()) - 1;
   normal.resize(N);
   kappa.resize(N);
-#pragma omp parallel for schedule(static)
-  for (int i = 0; i < N; ++i) {
+#pragma omp parallel
+  for (auto [i, end] = balanced_node_range(start_); i < end; ++i) {
     Vec3 Xs, Xt, Xss, Xst, Xtt;
     for (int j = start_[i]; j < start_[i + 1]; ++j) {
       const Vec3 d = X[nbr_[j]] - X[i];

@@ -8,6 +8,7 @@
 
 #include "immerse/core/Error.hpp"
 #include "immerse/core/Mat3.hpp"
+#include "immerse/membrane/BalancedRange.hpp"
 #include "immerse/membrane/MembraneKinematics_K.hpp"
 #include "immerse/membrane/QuadraticTriangle_K.hpp"
 
@@ -227,8 +228,8 @@ void ElasticMembrane::node_pass(const std::vector<Vec3>& X, bool with_tension, W
   int bad = INT_MAX;
   std::visit(
       [&](const auto& W) {
-#pragma omp parallel for schedule(static) reduction(min : bad)
-        for (int i = 0; i < N; ++i) {
+#pragma omp parallel reduction(min : bad)
+        for (auto [i, end] = balanced_node_range(inc_start_); i < end; ++i) {
           membrane_k::SymTensor tau;
           Vec3 n;
           for (int j = inc_start_[i]; j < inc_start_[i + 1]; ++j) {
@@ -245,8 +246,9 @@ void ElasticMembrane::node_pass(const std::vector<Vec3>& X, bool with_tension, W
             n += nk;
             if (!with_tension) continue;
             const RefMetric g = load_metric(ref_node_, slot);
-            const auto inv = membrane_k::invariants(t, J, g);
-            tau += membrane_k::tension(W(inv.A1, inv.A2), g.J / J, membrane_k::left_cauchy_green(t, g), nk);
+            const double r = J / g.J;  // e^{A1} (19)
+            tau += membrane_k::tension(W.at_area_ratio(r, membrane_k::second_invariant(t, g)), 1 / r,
+                                       membrane_k::left_cauchy_green(t, g), nk);
           }
           w.node_n[i] = normalized(n);
           if (with_tension) {
@@ -276,8 +278,8 @@ void ElasticMembrane::bending_passes(const std::vector<Vec3>& X, Work& w) const 
   const int N = static_cast<int>(num_nodes());
   moment_pass(X, w);
   w.node_q.resize(N);
-#pragma omp parallel for schedule(static)
-  for (int i = 0; i < N; ++i) {
+#pragma omp parallel
+  for (auto [i, end] = balanced_node_range(inc_start_); i < end; ++i) {
     Vec3 div;
     for (int j = inc_start_[i]; j < inc_start_[i + 1]; ++j) {
       const int slot = inc_[j], e = slot / 6, k = slot % 6;
@@ -351,8 +353,8 @@ void ElasticMembrane::energy_forces(const std::vector<Vec3>& X, Work& w) const {
             }
             const Frame fr = membrane_k::frame(t);
             const RefMetric g = load_metric(ref_quad_, 6 * e + q);
-            const auto inv = membrane_k::invariants(t, fr.J, g);
-            const auto dW = membrane_k::energy_gradient(W(inv.A1, inv.A2), t, fr, g);
+            const EnergyDensity d = W.at_area_ratio(fr.J / g.J, membrane_k::second_invariant(t, g));
+            const auto dW = membrane_k::energy_gradient(d, t, fr, g);
             const double jw = g.J * tri6::kQuad[q].w;
             for (int i = 0; i < 6; ++i) f[i] -= jw * (s.dxi[i] * dW.d_xi + s.deta[i] * dW.d_eta);
           }
@@ -377,8 +379,8 @@ void ElasticMembrane::compute_force(const std::vector<Vec3>& X, std::vector<Vec3
   // Node i collects its share of every element's force, slots in ascending element order.
   const int N = static_cast<int>(num_nodes());
   F.resize(N);
-#pragma omp parallel for schedule(static)
-  for (int i = 0; i < N; ++i) {
+#pragma omp parallel
+  for (auto [i, end] = balanced_node_range(inc_start_); i < end; ++i) {
     Vec3 s;
     for (int j = inc_start_[i]; j < inc_start_[i + 1]; ++j) {
       const int slot = inc_[j], e = slot / 6, k = slot % 6;
@@ -500,13 +502,14 @@ std::size_t ElasticMembrane::memory_bytes() const {
   const std::size_t N = num_nodes(), E = num_elements();
   const std::size_t persistent = E * sizeof(std::array<int, 6>) + N * sizeof(Vec3) +
                                  (inc_start_.size() + inc_.size()) * sizeof(int) +
-                                 (ref_node_.size() + ref_quad_.size() + kappa_ref_.size()) * sizeof(double);
-  // Workspace of compute_force (kept per calling thread): per node n, and tau (eq. 42 tension) or m and q
-  // (bending); per element F_e and the lumping fractions (eq. 42); the energy method's per-element-node forces.
+                                 (ref_node_.size() + ref_quad_.size() + kappa_ref_.size()) * sizeof(double) +
+                                 (fit_ ? fit_->memory_bytes() : 0);
+  // Workspace of compute_force (kept per calling thread): per node n, and tau (eq. 42 tension) or N, kappa, m and
+  // q (bending); per element F_e and the lumping fractions (eq. 42); the energy method's per-element-node forces.
   const bool bending = bending_.kappa_B > 0, energy = method_ == ForceMethod::Energy;
   const std::size_t work = (energy && !bending ? 0 : N * sizeof(Vec3)) +
                            (energy ? 0 : N * sizeof(membrane_k::SymTensor)) +
-                           (bending ? N * (sizeof(Mat3) + sizeof(Vec3)) : 0) +
+                           (bending ? N * 2 * (sizeof(Mat3) + sizeof(Vec3)) : 0) +
                            (energy && !bending ? 0 : E * (sizeof(Vec3) + sizeof(std::array<double, 6>))) +
                            (energy ? 6 * E * sizeof(Vec3) : 0);
   return persistent + work;

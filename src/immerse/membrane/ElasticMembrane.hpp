@@ -2,7 +2,8 @@
 // Elastic forces of a closed capsule membrane of six-node curved triangles (paper §2.3, §3, eqs. 15-27, 38-42).
 //
 // In-plane: the law W(A1, A2) (MaterialLaw) gives the tension tau (18) from B = A A^T (17), A from (39).
-// Bending:  m = kappa_B (kappa - kappa_m^R P) (25), kappa from (40), K = (P.grad) m from (41), q from (27).
+// Bending:  m = kappa_B (kappa - kappa_m^R P) (25), kappa = grad_s N (40) at the nodes from a local quartic fit
+//           (CurvatureFit), K = (P.grad) m from (41), q from (27).
 // Two ways to turn these into nodal forces (newtons, ready for spreading with eq. 6):
 //   ForceMethod::Contour  eq. (42): per element F_e = oint [b.tau + (b.q) n] dl along the three curved edges
 //                         (3-point Gauss on each quadratic edge), with tau, q, n interpolated from nodal values
@@ -11,8 +12,9 @@
 //   ForceMethod::Energy   F_i = -dE/dX_i of E = sum_e sum_gp W(A1, A2) Jbar w (6-point rule on each curved
 //                         element, A from the element's own interpolation): exact linear and angular momentum.
 //                         Bending (if kappa_B > 0) is added as the q-part of eq. (42); E holds no bending energy.
-// See docs/membrane-bending.md for the derivations, the lumping rule and the one deviation from the paper
-// (element-node tensions, not deformation gradients, are averaged at nodes).
+// See docs/membrane-bending.md for the derivations, the lumping rule and the two deviations from the paper
+// (element-node tensions, not deformation gradients, are averaged at nodes; nodal curvature by a local fit
+// instead of averaging the element-wise (40), so that the nodal bending load converges).
 #include <cstddef>
 #include <optional>
 #include <vector>
@@ -61,9 +63,9 @@ class ElasticMembrane {
   /// Lumped area a_i (m^2) each node carries at X; sum_i a_i = total area. Force density at node i = F_i / a_i
   /// for the contour method.
   std::vector<double> node_area(const std::vector<Vec3>& X) const;
-  /// Unit normal at each node: normalized average of the normals of the elements sharing it.
+  /// Unit normal at each node: normalized average of the normals of the elements sharing it (used by eq. 42).
   std::vector<Vec3> node_normal(const std::vector<Vec3>& X) const;
-  /// kappa_m^R of eq. (25) per node (1/m).
+  /// kappa_m^R of eq. (25) per node (1/m); zero unless kappa_B > 0 with ReferenceCurvature::RestShape.
   const std::vector<double>& reference_curvature() const { return kappa_ref_; }
 
   std::size_t num_nodes() const { return reference_.size(); }

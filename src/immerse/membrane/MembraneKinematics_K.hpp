@@ -105,10 +105,14 @@ struct Invariants {
   double A1, A2;
 };
 
+/// A2 (20) = tr(B)/2 - 1 = Gbar^{alpha beta} a_alpha . a_beta / 2 - 1.
+[[gnu::always_inline]] inline double second_invariant(const Tangents& t, const RefMetric& g) {
+  return 0.5 * (g.g_xx * dot(t.a_xi, t.a_xi) + 2 * g.g_xe * dot(t.a_xi, t.a_eta) + g.g_ee * dot(t.a_eta, t.a_eta)) -
+         1;
+}
+
 [[gnu::always_inline]] inline Invariants invariants(const Tangents& t, double J, const RefMetric& g) {
-  const double A2 = 0.5 * (g.g_xx * dot(t.a_xi, t.a_xi) + 2 * g.g_xe * dot(t.a_xi, t.a_eta) +
-                           g.g_ee * dot(t.a_eta, t.a_eta)) - 1;
-  return {std::log(J / g.J), A2};
+  return {std::log(J / g.J), second_invariant(t, g)};
 }
 
 /// Half the difference of the squared principal stretches, (lambda1^2 - lambda2^2)/2, from the eigenvalues of
