@@ -4,9 +4,10 @@
 // nodal normals, whose nodal error is only O(h) on a general surface (docs/membrane-bending.md, §2).
 //
 // Set-up (reference configuration Xbar, once): node i's neighbours p are all the nodes of the elements
-// incident to i and of the elements sharing an edge with those (21-37 nodes). They get local chart coordinates
-// (s_p, t_p) = ((Xbar_p - Xbar_i).e1, (Xbar_p - Xbar_i).e2) in the tangent plane of a first normal estimate
-// e3 (the normalized sum of the incident elements' chord normals). The least-squares fit of the 14 monomials
+// incident to i and of the elements sharing an edge with those (20 for a mid-side node, 30-36 for a vertex).
+// They get chart coordinates (s_p, t_p) = ((Xbar_p - Xbar_i).e1, (Xbar_p - Xbar_i).e2) in the tangent plane
+// of a first normal estimate e3 (the normalized sum of the incident elements' chord normals), scaled by the
+// neighbourhood radius. The least-squares fit of the 14 monomials
 // s^a t^b, 1 <= a + b <= 4, to values g_p - g_i is linear in the data: its derivatives at the node are fixed
 // weighted sums, g_s = sum_p w^s_p (g_p - g_i) and likewise g_t, g_ss, g_st, g_tt; the weights are stored.
 //
