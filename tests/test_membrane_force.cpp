@@ -171,3 +171,18 @@ TEST(MembraneForce, CurvatureFitConvergesOnEllipsoid) {
   EXPECT_GT(std::log2(err_h[1] / err_h[2]), 2.5);
   EXPECT_LT(err_h.back(), 1e-3);
 }
+
+// A neighbourhood that cannot carry the quartic fit (here: the whole reference collapsed onto a line) is bad
+// input naming the node.
+TEST(MembraneForce, CurvatureFitRejectsDegenerateNeighbourhood) {
+  const Mesh mesh = icosahedral_sphere(1);
+  std::vector<Vec3> line(mesh.nodes.size());
+  for (std::size_t i = 0; i < line.size(); ++i) line[i] = {static_cast<double>(i), 0, 0};
+  try {
+    const CurvatureFit fit(mesh, line);
+    FAIL();
+  } catch (const InputError& e) {
+    EXPECT_STREQ(e.what(), "membrane mesh node 0: must be a neighbourhood that determines the quartic curvature fit "
+                           "(well-shaped elements around it)");
+  }
+}
