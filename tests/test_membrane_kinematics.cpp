@@ -53,7 +53,7 @@ TEST(MembraneKinematics, DeformationGradientSolvesEq39) {
     EXPECT_LT(max_diff(A, F * (Mat3::identity() - Mat3::outer(fr.n, fr.n))), 1e-14);
     // B = A A^T through the reference metric (17); invariants (19), (20).
     const auto g = membrane_k::ref_metric(tr);
-    const Mat3 B = membrane_k::left_cauchy_green(t, g);
+    const Mat3 B = membrane_k::left_cauchy_green(t, g).full();
     EXPECT_LT(max_diff(B, A * transpose(A)), 1e-14);
     const auto inv = membrane_k::invariants(t, membrane_k::frame(t).J, g);
     const double trB = trace(B), trB2 = trace(B * B);
@@ -77,7 +77,8 @@ TEST(MembraneKinematics, PlanarStretchInvariantsAndTension) {
     const auto inv = membrane_k::invariants(t, f.J, g);
     EXPECT_NEAR(inv.A1, std::log(l1 * l2), 1e-14);
     EXPECT_NEAR(inv.A2, 0.5 * (l1 * l1 + l2 * l2) - 1, 1e-14);
-    const Mat3 tau = membrane_k::tension(law(inv.A1, inv.A2), inv.A1, membrane_k::left_cauchy_green(t, g), f.n);
+    const Mat3 tau =
+        membrane_k::tension(law(inv.A1, inv.A2), g.J / f.J, membrane_k::left_cauchy_green(t, g), f.n).full();
     const double J = l1 * l2;
     EXPECT_NEAR(tau(0, 0), Es / 3 * (l1 * l1 - 1 / (J * J)) / J, 1e-14);
     EXPECT_NEAR(tau(1, 1), Es / 3 * (l2 * l2 - 1 / (J * J)) / J, 1e-14);

@@ -4,9 +4,11 @@
 #include <climits>
 #include <cmath>
 #include <string>
+#include <utility>
 
 #include "immerse/core/Error.hpp"
 #include "immerse/core/Mat3.hpp"
+#include "immerse/membrane/BalancedRange.hpp"
 #include "immerse/membrane/MembraneKinematics_K.hpp"
 #include "immerse/membrane/QuadraticTriangle_K.hpp"
 
@@ -32,6 +34,52 @@ constexpr std::array<tri6::Shape, tri6::kQuadPoints> quad_shapes() {
 constexpr auto kNodeShape = node_shapes();
 constexpr auto kQuadShape = quad_shapes();
 
+/// Parametric derivatives at element node k of a field with values get(j) at the six nodes (38). Half of the
+/// shape-function derivatives vanish at the nodes; only the non-zero terms are summed (in the order of j).
+template <int k, class T, class Get>
+inline void node_derivatives(const Get& get, T& d_xi, T& d_eta) {
+  auto term = [&]<int j>() {
+    constexpr double cx = kNodeShape[k].dxi[j], ce = kNodeShape[k].deta[j];
+    if constexpr (cx != 0 || ce != 0) {
+      const T v = get(j);
+      if constexpr (cx != 0) d_xi += cx * v;
+      if constexpr (ce != 0) d_eta += ce * v;
+    }
+  };
+  [&]<int... j>(std::integer_sequence<int, j...>) { (term.template operator()<j>(), ...); }(
+      std::make_integer_sequence<int, tri6::kNodes>{});
+}
+
+template <class T, class Get>
+[[gnu::always_inline]] inline void node_derivatives(int k, const Get& get, T& d_xi, T& d_eta) {
+  switch (k) {
+    case 0: node_derivatives<0>(get, d_xi, d_eta); break;
+    case 1: node_derivatives<1>(get, d_xi, d_eta); break;
+    case 2: node_derivatives<2>(get, d_xi, d_eta); break;
+    case 3: node_derivatives<3>(get, d_xi, d_eta); break;
+    case 4: node_derivatives<4>(get, d_xi, d_eta); break;
+    default: node_derivatives<5>(get, d_xi, d_eta); break;
+  }
+}
+
+/// Edge quadrature of eq. (42) at Gauss point g: edge shape values, weight w_g and the products w_g L_j(s_g).
+struct EdgePoint {
+  tri6::EdgeShape s;
+  double w;
+  std::array<double, 3> wL;
+};
+constexpr std::array<EdgePoint, 3> edge_points() {
+  std::array<EdgePoint, 3> p{};
+  for (int g = 0; g < 3; ++g) {
+    p[g].s = tri6::edge_shape(tri6::kEdgeS[g]);
+    p[g].w = tri6::kEdgeW[g];
+    for (int j = 0; j < 3; ++j) p[g].wL[j] = tri6::kEdgeW[g] * p[g].s.L[j];
+  }
+  return p;
+}
+constexpr auto kEdgePoints = edge_points();
+
+
 Nodes element_nodes(const std::array<int, 6>& el, const std::vector<Vec3>& X) {
   Nodes x;
   for (int i = 0; i < tri6::kNodes; ++i) x[i] = X[el[i]];
@@ -40,12 +88,23 @@ Nodes element_nodes(const std::array<int, 6>& el, const std::vector<Vec3>& X) {
 
 /// Jacobian signed against the element's chord normal (x1 - x0) x (x2 - x0): an inverted, folded or
 /// degenerate element has a point where it is <= 0 (or not finite).
-bool jacobian_ok(const Tangents& t, const Vec3& chord) {
+[[gnu::always_inline]] inline bool jacobian_ok(const Tangents& t, const Vec3& chord) {
   const double s = dot(cross(t.a_xi, t.a_eta), chord);
   return s > 0 && std::isfinite(s);
 }
 
-Vec3 chord_normal(const Nodes& x) { return cross(x[1] - x[0], x[2] - x[0]); }
+[[gnu::always_inline]] inline Vec3 chord_normal(const Nodes& x) { return cross(x[1] - x[0], x[2] - x[0]); }
+[[gnu::always_inline]] inline Vec3 chord_normal(const std::array<int, 6>& el, const std::vector<Vec3>& X) {
+  return cross(X[el[1]] - X[el[0]], X[el[2]] - X[el[0]]);
+}
+
+/// Tangents at local node k of element el.
+[[gnu::always_inline]] inline Tangents slot_tangents(const std::array<int, 6>& el, int k, const std::vector<Vec3>& X) {
+  Tangents t;
+  node_derivatives(k, [&](int j) { return X[el[j]]; }, t.a_xi, t.a_eta);
+  return t;
+}
+
 
 void throw_if_bad(int bad) {
   if (bad != INT_MAX)
@@ -74,7 +133,8 @@ std::array<double, 6> lumping_fractions(const Nodes& x) {
     for (int k : s) f[k] += a;
     total += 3 * a;
   }
-  for (double& v : f) v /= total;
+  const double r = 1 / total;
+  for (double& v : f) v *= r;
   return f;
 }
 
@@ -82,14 +142,25 @@ Mat3 projector(const Vec3& n) { return Mat3::identity() - Mat3::outer(n, n); }
 
 }  // namespace
 
+// Scratch data of one compute_force. compute_force keeps one per calling thread (workspace()), so repeated calls
+// neither allocate nor zero-fill (a serial, memory-bound step) and concurrent calls from different threads stay
+// independent. Every entry a pass reads was written earlier in the same call.
 struct ElasticMembrane::Work {
-  std::vector<Mat3> en_tau, node_tau;      // tension (18) at element nodes / averaged at nodes
-  std::vector<Vec3> en_n, node_n;          // unit normal
-  std::vector<Mat3> en_kappa, node_kappa;  // curvature (40)
-  std::vector<Mat3> node_m;                // moments (25)
-  std::vector<Vec3> en_div, node_q;        // (P.grad).m from (41); transverse shear tension (27)
-  std::vector<Vec3> en_force;              // each element's force on each of its nodes
+  std::vector<membrane_k::SymTensor> node_tau;  // tension (18) averaged at nodes
+  std::vector<Vec3> node_n;                     // unit normal at nodes
+  std::vector<Vec3> node_nfit;                  // fitted unit normal N at nodes (bending)
+  std::vector<Mat3> node_kappa;                 // fitted curvature tensor (40) at nodes (bending)
+  std::vector<Mat3> node_m;                     // moments (25)
+  std::vector<Vec3> node_q;                     // transverse shear tension (27)
+  std::vector<Vec3> el_force;                   // F_e of eq. (42) per element
+  std::vector<std::array<double, 6>> el_frac;   // lumping fractions per element
+  std::vector<Vec3> en_force;                   // energy method: each element's force on each of its nodes
 };
+
+ElasticMembrane::Work& ElasticMembrane::workspace() {
+  thread_local Work w;
+  return w;
+}
 
 ElasticMembrane::ElasticMembrane(const Mesh& mesh, std::vector<Vec3> reference, MaterialLaw law, Bending bending,
                                  ForceMethod method)
@@ -135,8 +206,9 @@ ElasticMembrane::ElasticMembrane(const Mesh& mesh, std::vector<Vec3> reference, 
       store_metric(ref_quad_, 6 * e + k, membrane_k::ref_metric(tq));
     }
   }
-  kappa_ref_ = bending_.reference == ReferenceCurvature::RestShape ? reference_mean_curvature()
-                                                                   : std::vector<double>(N, 0.0);
+  if (bending_.kappa_B > 0) fit_.emplace(mesh, reference_);
+  kappa_ref_ = fit_ && bending_.reference == ReferenceCurvature::RestShape ? reference_mean_curvature()
+                                                                          : std::vector<double>(N, 0.0);
 }
 
 void ElasticMembrane::check_size(const std::vector<Vec3>& X) const {
@@ -144,160 +216,119 @@ void ElasticMembrane::check_size(const std::vector<Vec3>& X) const {
           "equal to the node count " + std::to_string(reference_.size()));
 }
 
-namespace {
+// Node passes. A node's value is the mean over its element-node slots (ascending element order) of a quantity
+// evaluated at that element node: no per-element-node array is stored, and the result does not depend on the
+// thread count.
 
-/// The surface derivative of a nodal field g at every element node, as eqs. (40) and (41) need it:
-/// out[6e + k] = op(frame at node k of element e, dg/dxi, dg/deta), with g interpolated by the shape functions (38).
-template <class T, class Op>
-void element_node_derivative(const std::vector<std::array<int, 6>>& elements, const std::vector<Vec3>& X,
-                             const std::vector<T>& g, Op op, std::vector<decltype(op(Frame{}, T{}, T{}))>& out) {
-  const int E = static_cast<int>(elements.size());
-  out.resize(6 * static_cast<std::size_t>(E));
-#pragma omp parallel for schedule(static)
-  for (int e = 0; e < E; ++e) {
-    const auto& el = elements[e];
-    const Nodes x = element_nodes(el, X);
-    for (int k = 0; k < 6; ++k) {
-      const tri6::Shape& s = kNodeShape[k];
-      const Frame f = membrane_k::frame(membrane_k::tangents(x, s));
-      T dg_dxi{}, dg_deta{};
-      for (int j = 0; j < 6; ++j) {
-        dg_dxi += s.dxi[j] * g[el[j]];
-        dg_deta += s.deta[j] * g[el[j]];
-      }
-      out[6 * e + k] = op(f, dg_dxi, dg_deta);
-    }
-  }
-}
-
-/// node[i] = mean over the element-node slots of node i (fixed order).
-template <class T>
-void average(const std::vector<int>& start, const std::vector<int>& inc, const std::vector<T>& en,
-             std::vector<T>& node) {
-  const int N = static_cast<int>(start.size()) - 1;
-  node.resize(N);
-#pragma omp parallel for schedule(static)
-  for (int i = 0; i < N; ++i) {
-    T s{};
-    for (int j = start[i]; j < start[i + 1]; ++j) s += en[inc[j]];
-    s *= 1.0 / (start[i + 1] - start[i]);
-    node[i] = s;
-  }
-}
-
-}  // namespace
-
-void ElasticMembrane::gather(const std::vector<Vec3>& en, std::vector<Vec3>& node) const {
+// Normal n and (optionally) tension (17)-(20), (18) from (39) at each element node, averaged at the nodes.
+void ElasticMembrane::node_pass(const std::vector<Vec3>& X, bool with_tension, Work& w) const {
   const int N = static_cast<int>(num_nodes());
-  node.resize(N);
-#pragma omp parallel for schedule(static)
-  for (int i = 0; i < N; ++i) {
-    Vec3 s{};
-    for (int j = inc_start_[i]; j < inc_start_[i + 1]; ++j) s += en[inc_[j]];
-    node[i] = s;
-  }
-}
-
-// Element nodes: normal n and (optionally) tension (17)-(20), (18) from (39); then averaged at the nodes.
-void ElasticMembrane::element_node_pass(const std::vector<Vec3>& X, bool with_tension, Work& w) const {
-  const int E = static_cast<int>(num_elements());
-  w.en_n.resize(6 * E);
-  if (with_tension) w.en_tau.resize(6 * E);
+  w.node_n.resize(N);
+  if (with_tension) w.node_tau.resize(N);
   int bad = INT_MAX;
   std::visit(
       [&](const auto& W) {
-#pragma omp parallel for schedule(static) reduction(min : bad)
-        for (int e = 0; e < E; ++e) {
-          const Nodes x = element_nodes(elements_[e], X);
-          const Vec3 chord = chord_normal(x);
-          for (int k = 0; k < 6; ++k) {
-            const Tangents t = membrane_k::tangents(x, kNodeShape[k]);
-            if (!jacobian_ok(t, chord)) {
+#pragma omp parallel reduction(min : bad)
+        for (auto [i, end] = balanced_node_range(inc_start_); i < end; ++i) {
+          membrane_k::SymTensor tau;
+          Vec3 n;
+          for (int j = inc_start_[i]; j < inc_start_[i + 1]; ++j) {
+            const int slot = inc_[j], e = slot / 6, k = slot % 6;
+            const auto& el = elements_[e];
+            const Tangents t = slot_tangents(el, k, X);
+            const Vec3 c = cross(t.a_xi, t.a_eta);  // J n, as in membrane_k::frame (dual basis not needed here)
+            if (!jacobian_ok(t, chord_normal(el, X))) {
               bad = std::min(bad, e);
-              break;
+              continue;
             }
-            const Frame f = membrane_k::frame(t);
-            w.en_n[6 * e + k] = f.n;
+            const double J = norm(c);
+            const Vec3 nk = c * (1 / J);
+            n += nk;
             if (!with_tension) continue;
-            const RefMetric g = load_metric(ref_node_, 6 * e + k);
-            const auto inv = membrane_k::invariants(t, f.J, g);
-            w.en_tau[6 * e + k] =
-                membrane_k::tension(W(inv.A1, inv.A2), inv.A1, membrane_k::left_cauchy_green(t, g), f.n);
+            const RefMetric g = load_metric(ref_node_, slot);
+            const double r = J / g.J;  // e^{A1} (19)
+            tau += membrane_k::tension(W.at_area_ratio(r, membrane_k::second_invariant(t, g)), 1 / r,
+                                       membrane_k::left_cauchy_green(t, g), nk);
+          }
+          w.node_n[i] = normalized(n);
+          if (with_tension) {
+            tau *= 1.0 / (inc_start_[i + 1] - inc_start_[i]);
+            w.node_tau[i] = tau;
           }
         }
       },
       law_);
   throw_if_bad(bad);
-  if (with_tension) average(inc_start_, inc_, w.en_tau, w.node_tau);
-  average(inc_start_, inc_, w.en_n, w.node_n);
-  for (Vec3& n : w.node_n) n = normalized(n);
 }
 
-// Curvature tensor (40) at element nodes from the interpolated nodal normals, averaged at the nodes.
-void ElasticMembrane::curvature_pass(const std::vector<Vec3>& X, Work& w) const {
-  element_node_derivative(elements_, X, w.node_n, membrane_k::curvature, w.en_kappa);
-  average(inc_start_, inc_, w.en_kappa, w.node_kappa);
-}
-
-// Bending: kappa (40) averaged at nodes; m (25) at nodes; (P.grad).m = tr K (41) at element nodes from the
-// interpolated nodal moments, averaged; q (27) at nodes.
-void ElasticMembrane::bending_passes(const std::vector<Vec3>& X, Work& w) const {
+// Bending moments (25), m = kappa_B (kappa - kappa_m^R P), P = I - N N, with the nodal normal N and curvature
+// tensor kappa (40) from the local quartic fit (CurvatureFit).
+void ElasticMembrane::moment_pass(const std::vector<Vec3>& X, Work& w) const {
   const int N = static_cast<int>(num_nodes());
-  curvature_pass(X, w);
-
+  fit_->compute(X, w.node_nfit, w.node_kappa);
   w.node_m.resize(N);
 #pragma omp parallel for schedule(static)
   for (int i = 0; i < N; ++i)
-    w.node_m[i] = bending_.kappa_B * (w.node_kappa[i] - kappa_ref_[i] * projector(w.node_n[i]));
-
-  element_node_derivative(elements_, X, w.node_m, membrane_k::moment_divergence, w.en_div);
-  average(inc_start_, inc_, w.en_div, w.node_q);
-#pragma omp parallel for schedule(static)
-  for (int i = 0; i < N; ++i) w.node_q[i] = w.node_q[i] * projector(w.node_n[i]);
+    w.node_m[i] = bending_.kappa_B * (w.node_kappa[i] - kappa_ref_[i] * projector(w.node_nfit[i]));
 }
 
-// Eq. (42): F_e = S_e fbar_e = oint [b.tau + (b.q) n] dl, b dl = (dX/ds x n) ds along each curved edge,
-// with tau, q, n interpolated quadratically from the nodal values; then shared among the element's nodes.
+// Bending: moments (25) at the nodes; (P.grad).m = tr K (41) at element nodes from the interpolated nodal
+// moments, averaged; q (27) at nodes with the fitted normal's projector.
+void ElasticMembrane::bending_passes(const std::vector<Vec3>& X, Work& w) const {
+  const int N = static_cast<int>(num_nodes());
+  moment_pass(X, w);
+  w.node_q.resize(N);
+#pragma omp parallel
+  for (auto [i, end] = balanced_node_range(inc_start_); i < end; ++i) {
+    Vec3 div;
+    for (int j = inc_start_[i]; j < inc_start_[i + 1]; ++j) {
+      const int slot = inc_[j], e = slot / 6, k = slot % 6;
+      const auto& el = elements_[e];
+      const Frame f = membrane_k::frame(slot_tangents(el, k, X));
+      Mat3 dm_dxi, dm_deta;
+      node_derivatives(k, [&](int m) { return w.node_m[el[m]]; }, dm_dxi, dm_deta);
+      div += membrane_k::moment_divergence(f, dm_dxi, dm_deta);
+    }
+    div *= 1.0 / (inc_start_[i + 1] - inc_start_[i]);
+    w.node_q[i] = div * projector(w.node_nfit[i]);
+  }
+}
+
+// Eq. (42): F_e = S_e fbar_e = oint [b.tau + (b.q) n] dl, b dl = (dX/ds x n) ds along each curved edge, with
+// tau, q, n interpolated quadratically from the nodal values. The tension part is linear in the nodal tau:
+// sum_g w_g tau(s_g) b_g = sum_j tau_j beta_j, beta_j = sum_g w_g L_j(s_g) b_g, accumulated per element node.
 void ElasticMembrane::contour_forces(const std::vector<Vec3>& X, bool with_tension, bool with_bending,
                                      Work& w) const {
   const int E = static_cast<int>(num_elements());
-  w.en_force.resize(6 * E);
-  const bool accumulate = method_ == ForceMethod::Energy;
+  w.el_force.resize(E);
+  w.el_frac.resize(E);
 #pragma omp parallel for schedule(static)
   for (int e = 0; e < E; ++e) {
     const auto& el = elements_[e];
     const Nodes x = element_nodes(el, X);
+    std::array<Vec3, 6> beta{};
     Vec3 Fe;
     for (const auto& edge : tri6::kEdges)
-      for (int g = 0; g < 3; ++g) {
-        const tri6::EdgeShape es = tri6::edge_shape(tri6::kEdgeS[g]);
+      for (const EdgePoint& p : kEdgePoints) {
         Vec3 dX, n;
         for (int j = 0; j < 3; ++j) {
-          dX += es.dL[j] * x[edge[j]];
-          n += es.L[j] * w.node_n[el[edge[j]]];
+          dX += p.s.dL[j] * x[edge[j]];
+          n += p.s.L[j] * w.node_n[el[edge[j]]];
         }
-        n = normalized(n);
+        n *= 1 / norm(n);
         const Vec3 b = cross(dX, n);
-        Vec3 c;
-        if (with_tension) {
-          Mat3 tau;
-          for (int j = 0; j < 3; ++j) tau += es.L[j] * w.node_tau[el[edge[j]]];
-          c += tau * b;
-        }
+        if (with_tension)
+          for (int j = 0; j < 3; ++j) beta[edge[j]] += p.wL[j] * b;
         if (with_bending) {
           Vec3 q;
-          for (int j = 0; j < 3; ++j) q += es.L[j] * w.node_q[el[edge[j]]];
-          c += dot(b, q) * n;
+          for (int j = 0; j < 3; ++j) q += p.s.L[j] * w.node_q[el[edge[j]]];
+          Fe += (p.w * dot(b, q)) * n;
         }
-        Fe += tri6::kEdgeW[g] * c;
       }
-    const auto frac = lumping_fractions(x);
-    for (int k = 0; k < 6; ++k) {
-      if (accumulate)
-        w.en_force[6 * e + k] += frac[k] * Fe;
-      else
-        w.en_force[6 * e + k] = frac[k] * Fe;
-    }
+    if (with_tension)
+      for (int k = 0; k < 6; ++k) Fe += w.node_tau[el[k]] * beta[k];
+    w.el_force[e] = Fe;
+    w.el_frac[e] = lumping_fractions(x);
   }
 }
 
@@ -322,8 +353,8 @@ void ElasticMembrane::energy_forces(const std::vector<Vec3>& X, Work& w) const {
             }
             const Frame fr = membrane_k::frame(t);
             const RefMetric g = load_metric(ref_quad_, 6 * e + q);
-            const auto inv = membrane_k::invariants(t, fr.J, g);
-            const auto dW = membrane_k::energy_gradient(W(inv.A1, inv.A2), t, fr, g);
+            const EnergyDensity d = W.at_area_ratio(fr.J / g.J, membrane_k::second_invariant(t, g));
+            const auto dW = membrane_k::energy_gradient(d, t, fr, g);
             const double jw = g.J * tri6::kQuad[q].w;
             for (int i = 0; i < 6; ++i) f[i] -= jw * (s.dxi[i] * dW.d_xi + s.deta[i] * dW.d_eta);
           }
@@ -336,17 +367,34 @@ void ElasticMembrane::energy_forces(const std::vector<Vec3>& X, Work& w) const {
 
 void ElasticMembrane::compute_force(const std::vector<Vec3>& X, std::vector<Vec3>& F) const {
   check_size(X);
-  Work w;
-  const bool tension_by_contour = method_ == ForceMethod::Contour;
+  Work& w = workspace();
+  const bool energy = method_ == ForceMethod::Energy;
   const bool bending = bending_.kappa_B > 0;
-  if (method_ == ForceMethod::Energy) energy_forces(X, w);
-  if (tension_by_contour || bending) {
-    element_node_pass(X, tension_by_contour, w);
+  if (energy) energy_forces(X, w);
+  if (!energy || bending) {
+    node_pass(X, !energy, w);
     if (bending) bending_passes(X, w);
-    contour_forces(X, tension_by_contour, bending, w);
+    contour_forces(X, !energy, bending, w);
   }
-  gather(w.en_force, F);
+  // Node i collects its share of every element's force, slots in ascending element order.
+  const int N = static_cast<int>(num_nodes());
+  F.resize(N);
+#pragma omp parallel
+  for (auto [i, end] = balanced_node_range(inc_start_); i < end; ++i) {
+    Vec3 s;
+    for (int j = inc_start_[i]; j < inc_start_[i + 1]; ++j) {
+      const int slot = inc_[j], e = slot / 6, k = slot % 6;
+      if (!energy)
+        s += w.el_frac[e][k] * w.el_force[e];
+      else if (bending)
+        s += w.en_force[slot] + w.el_frac[e][k] * w.el_force[e];
+      else
+        s += w.en_force[slot];
+    }
+    F[i] = s;
+  }
 }
+
 
 double ElasticMembrane::compute_energy(const std::vector<Vec3>& X) const {
   check_size(X);
@@ -398,13 +446,14 @@ std::vector<NodeStrain> ElasticMembrane::node_strain(const std::vector<Vec3>& X)
     }
   }
   throw_if_bad(bad);
-  std::vector<Vec3> inv;
-  average(inc_start_, inc_, en_inv, inv);
   std::vector<NodeStrain> out(num_nodes());
   for (std::size_t i = 0; i < out.size(); ++i) {
-    const double A1 = inv[i].x, A2 = inv[i].y;
+    Vec3 inv;  // mean over the node's element-node slots
+    for (int j = inc_start_[i]; j < inc_start_[i + 1]; ++j) inv += en_inv[inc_[j]];
+    inv *= 1.0 / (inc_start_[i + 1] - inc_start_[i]);
+    const double A1 = inv.x, A2 = inv.y;
     // lambda_k^2 = A2 + 1 +- r; (18) in principal axes: tau_k = e^{-A1} (dW/dA1 + dW/dA2 lambda_k^2).
-    const double s = A2 + 1, p = std::exp(A1), r = inv[i].z;
+    const double s = A2 + 1, p = std::exp(A1), r = inv.z;
     const EnergyDensity d = energy_density(law_, A1, A2);
     out[i] = {A1, A2, std::sqrt(s + r), std::sqrt(std::max(0.0, s - r)), (d.dW_dA1 + d.dW_dA2 * (s + r)) / p,
               (d.dW_dA1 + d.dW_dA2 * (s - r)) / p};
@@ -415,37 +464,37 @@ std::vector<NodeStrain> ElasticMembrane::node_strain(const std::vector<Vec3>& X)
 std::vector<double> ElasticMembrane::node_area(const std::vector<Vec3>& X) const {
   check_size(X);
   const int E = static_cast<int>(num_elements());
-  std::vector<Vec3> en_area(6 * E);  // area share in .x (gather works on Vec3)
+  std::vector<double> S(E);
+  std::vector<std::array<double, 6>> frac(E);
 #pragma omp parallel for schedule(static)
   for (int e = 0; e < E; ++e) {
     const Nodes x = element_nodes(elements_[e], X);
-    double S = 0;
+    double s = 0;
     for (int q = 0; q < tri6::kQuadPoints; ++q)
-      S += membrane_k::frame(membrane_k::tangents(x, kQuadShape[q])).J * tri6::kQuad[q].w;
-    const auto frac = lumping_fractions(x);
-    for (int k = 0; k < 6; ++k) en_area[6 * e + k] = {frac[k] * S, 0, 0};
+      s += membrane_k::frame(membrane_k::tangents(x, kQuadShape[q])).J * tri6::kQuad[q].w;
+    S[e] = s;
+    frac[e] = lumping_fractions(x);
   }
-  std::vector<Vec3> node;
-  gather(en_area, node);
-  std::vector<double> a(node.size());
-  for (std::size_t i = 0; i < a.size(); ++i) a[i] = node[i].x;
+  std::vector<double> a(num_nodes());
+  for (std::size_t i = 0; i < a.size(); ++i)
+    for (int j = inc_start_[i]; j < inc_start_[i + 1]; ++j) a[i] += frac[inc_[j] / 6][inc_[j] % 6] * S[inc_[j] / 6];
   return a;
 }
 
 std::vector<Vec3> ElasticMembrane::node_normal(const std::vector<Vec3>& X) const {
   check_size(X);
   Work w;
-  element_node_pass(X, false, w);
+  node_pass(X, false, w);
   return w.node_n;
 }
 
 // kappa_m^R = tr(kappa)/2 of the reference shape, kappa from (40) averaged at the nodes.
 std::vector<double> ElasticMembrane::reference_mean_curvature() const {
-  Work w;
-  element_node_pass(reference_, false, w);
-  curvature_pass(reference_, w);
+  std::vector<Vec3> normal;
+  std::vector<Mat3> kappa;
+  fit_->compute(reference_, normal, kappa);
   std::vector<double> c(num_nodes());
-  for (std::size_t i = 0; i < c.size(); ++i) c[i] = 0.5 * trace(w.node_kappa[i]);
+  for (std::size_t i = 0; i < c.size(); ++i) c[i] = 0.5 * trace(kappa[i]);
   return c;
 }
 
@@ -453,10 +502,16 @@ std::size_t ElasticMembrane::memory_bytes() const {
   const std::size_t N = num_nodes(), E = num_elements();
   const std::size_t persistent = E * sizeof(std::array<int, 6>) + N * sizeof(Vec3) +
                                  (inc_start_.size() + inc_.size()) * sizeof(int) +
-                                 (ref_node_.size() + ref_quad_.size() + kappa_ref_.size()) * sizeof(double);
-  // Workspace of one compute_force with bending (the largest): per element node tau, n, kappa, div, force;
-  // per node tau, n, kappa, m, q.
-  const std::size_t work = 6 * E * (2 * sizeof(Mat3) + 3 * sizeof(Vec3)) + N * (3 * sizeof(Mat3) + 2 * sizeof(Vec3));
+                                 (ref_node_.size() + ref_quad_.size() + kappa_ref_.size()) * sizeof(double) +
+                                 (fit_ ? fit_->memory_bytes() : 0);
+  // Workspace of compute_force (kept per calling thread): per node n, and tau (eq. 42 tension) or N, kappa, m and
+  // q (bending); per element F_e and the lumping fractions (eq. 42); the energy method's per-element-node forces.
+  const bool bending = bending_.kappa_B > 0, energy = method_ == ForceMethod::Energy;
+  const std::size_t work = (energy && !bending ? 0 : N * sizeof(Vec3)) +
+                           (energy ? 0 : N * sizeof(membrane_k::SymTensor)) +
+                           (bending ? N * 2 * (sizeof(Mat3) + sizeof(Vec3)) : 0) +
+                           (energy && !bending ? 0 : E * (sizeof(Vec3) + sizeof(std::array<double, 6>))) +
+                           (energy ? 6 * E * sizeof(Vec3) : 0);
   return persistent + work;
 }
 

@@ -2,7 +2,8 @@
 // Elastic forces of a closed capsule membrane of six-node curved triangles (paper §2.3, §3, eqs. 15-27, 38-42).
 //
 // In-plane: the law W(A1, A2) (MaterialLaw) gives the tension tau (18) from B = A A^T (17), A from (39).
-// Bending:  m = kappa_B (kappa - kappa_m^R P) (25), kappa from (40), K = (P.grad) m from (41), q from (27).
+// Bending:  m = kappa_B (kappa - kappa_m^R P) (25), kappa = grad_s N (40) at the nodes from a local quartic fit
+//           (CurvatureFit), K = (P.grad) m from (41), q from (27).
 // Two ways to turn these into nodal forces (newtons, ready for spreading with eq. 6):
 //   ForceMethod::Contour  eq. (42): per element F_e = oint [b.tau + (b.q) n] dl along the three curved edges
 //                         (3-point Gauss on each quadratic edge), with tau, q, n interpolated from nodal values
@@ -11,12 +12,15 @@
 //   ForceMethod::Energy   F_i = -dE/dX_i of E = sum_e sum_gp W(A1, A2) Jbar w (6-point rule on each curved
 //                         element, A from the element's own interpolation): exact linear and angular momentum.
 //                         Bending (if kappa_B > 0) is added as the q-part of eq. (42); E holds no bending energy.
-// See docs/membrane-bending.md for the derivations, the lumping rule and the one deviation from the paper
-// (element-node tensions, not deformation gradients, are averaged at nodes).
+// See docs/membrane-bending.md for the derivations, the lumping rule and the two deviations from the paper
+// (element-node tensions, not deformation gradients, are averaged at nodes; nodal curvature by a local fit
+// instead of averaging the element-wise (40), so that the nodal bending load converges).
 #include <cstddef>
+#include <optional>
 #include <vector>
 
 #include "immerse/core/Vec3.hpp"
+#include "immerse/membrane/CurvatureFit.hpp"
 #include "immerse/membrane/MaterialLaw.hpp"
 #include "immerse/membrane/Mesh.hpp"
 
@@ -59,26 +63,27 @@ class ElasticMembrane {
   /// Lumped area a_i (m^2) each node carries at X; sum_i a_i = total area. Force density at node i = F_i / a_i
   /// for the contour method.
   std::vector<double> node_area(const std::vector<Vec3>& X) const;
-  /// Unit normal at each node: normalized average of the normals of the elements sharing it.
+  /// Unit normal at each node: normalized average of the normals of the elements sharing it (used by eq. 42).
   std::vector<Vec3> node_normal(const std::vector<Vec3>& X) const;
-  /// kappa_m^R of eq. (25) per node (1/m).
+  /// kappa_m^R of eq. (25) per node (1/m); zero unless kappa_B > 0 with ReferenceCurvature::RestShape.
   const std::vector<double>& reference_curvature() const { return kappa_ref_; }
 
   std::size_t num_nodes() const { return reference_.size(); }
   std::size_t num_elements() const { return elements_.size(); }
   ForceMethod method() const { return method_; }
-  /// Bytes held by this object (reference data, incidence) plus the workspace one compute_force allocates.
+  /// Bytes held by this object (reference data, incidence) plus the workspace compute_force keeps per calling
+  /// thread.
   std::size_t memory_bytes() const;
 
  private:
   struct Work;
+  static Work& workspace();  ///< compute_force's scratch data, one per calling thread
   void check_size(const std::vector<Vec3>& X) const;
-  void element_node_pass(const std::vector<Vec3>& X, bool with_tension, Work& w) const;
-  void curvature_pass(const std::vector<Vec3>& X, Work& w) const;
+  void node_pass(const std::vector<Vec3>& X, bool with_tension, Work& w) const;
+  void moment_pass(const std::vector<Vec3>& X, Work& w) const;
   void bending_passes(const std::vector<Vec3>& X, Work& w) const;
   void contour_forces(const std::vector<Vec3>& X, bool with_tension, bool with_bending, Work& w) const;
   void energy_forces(const std::vector<Vec3>& X, Work& w) const;
-  void gather(const std::vector<Vec3>& en, std::vector<Vec3>& node) const;
   std::vector<double> reference_mean_curvature() const;
 
   std::vector<std::array<int, 6>> elements_;
@@ -91,6 +96,7 @@ class ElasticMembrane {
   std::vector<double> ref_node_;  ///< per element node: Gbar^{xx}, Gbar^{xe}, Gbar^{ee}, Jbar (4 doubles)
   std::vector<double> ref_quad_;  ///< per quadrature point: Gbar^{xx}, Gbar^{xe}, Gbar^{ee}, Jbar w
   std::vector<double> kappa_ref_;
+  std::optional<CurvatureFit> fit_;  ///< nodal normal and curvature for the bending moments (kappa_B > 0)
 };
 
 }  // namespace immerse

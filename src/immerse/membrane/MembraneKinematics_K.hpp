@@ -30,7 +30,7 @@ struct Tangents {
 };
 
 /// a_alpha = sum_i x_i dN_i/dalpha (eq. 38 differentiated).
-inline Tangents tangents(const Nodes& x, const tri6::Shape& s) {
+[[gnu::always_inline]] inline Tangents tangents(const Nodes& x, const tri6::Shape& s) {
   Tangents t;
   for (int i = 0; i < tri6::kNodes; ++i) {
     t.a_xi += s.dxi[i] * x[i];
@@ -46,11 +46,11 @@ struct Frame {
   Vec3 d_xi, d_eta;  ///< a^xi, a^eta: a^alpha . a_beta = delta, a^alpha . n = 0
 };
 
-inline Frame frame(const Tangents& t) {
+[[gnu::always_inline]] inline Frame frame(const Tangents& t) {
   const Vec3 c = cross(t.a_xi, t.a_eta);
-  const double J = norm(c);
-  const Vec3 n = c / J;
-  return {n, J, cross(t.a_eta, n) / J, cross(n, t.a_xi) / J};
+  const double J = norm(c), r = 1 / J;
+  const Vec3 n = c * r;
+  return {n, J, cross(t.a_eta, n) * r, cross(n, t.a_xi) * r};
 }
 
 /// Reference-configuration data a point needs: contravariant metric Gbar^{alpha beta} and Jacobian Jbar.
@@ -58,7 +58,7 @@ struct RefMetric {
   double g_xx, g_xe, g_ee, J;
 };
 
-inline RefMetric ref_metric(const Tangents& t) {
+[[gnu::always_inline]] inline RefMetric ref_metric(const Tangents& t) {
   const Frame f = frame(t);
   return {dot(f.d_xi, f.d_xi), dot(f.d_xi, f.d_eta), dot(f.d_eta, f.d_eta), f.J};
 }
@@ -68,11 +68,36 @@ inline Mat3 deformation_gradient(const Tangents& t, const Frame& ref) {
   return Mat3::outer(t.a_xi, ref.d_xi) + Mat3::outer(t.a_eta, ref.d_eta);
 }
 
-/// Left Cauchy-Green tensor B = A A^T (17) through the reference metric.
-inline Mat3 left_cauchy_green(const Tangents& t, const RefMetric& g) {
-  const Mat3 xe = Mat3::outer(t.a_xi, t.a_eta);
-  return g.g_xx * Mat3::outer(t.a_xi, t.a_xi) + g.g_ee * Mat3::outer(t.a_eta, t.a_eta) +
-         g.g_xe * (xe + transpose(xe));
+/// A symmetric 3x3 tensor by its six independent components (B, P and the tension tau are symmetric).
+struct SymTensor {
+  double xx = 0, xy = 0, xz = 0, yy = 0, yz = 0, zz = 0;
+
+  SymTensor& operator+=(const SymTensor& b) {
+    xx += b.xx; xy += b.xy; xz += b.xz; yy += b.yy; yz += b.yz; zz += b.zz;
+    return *this;
+  }
+  SymTensor& operator*=(double s) {
+    xx *= s; xy *= s; xz *= s; yy *= s; yz *= s; zz *= s;
+    return *this;
+  }
+  Mat3 full() const { return Mat3::from_rows({xx, xy, xz}, {xy, yy, yz}, {xz, yz, zz}); }
+};
+
+/// T v for a symmetric T.
+inline Vec3 operator*(const SymTensor& t, const Vec3& v) {
+  return {t.xx * v.x + t.xy * v.y + t.xz * v.z, t.xy * v.x + t.yy * v.y + t.yz * v.z,
+          t.xz * v.x + t.yz * v.y + t.zz * v.z};
+}
+
+/// Left Cauchy-Green tensor B = A A^T (17) through the reference metric:
+/// B = Gbar^{xx} a_xi a_xi + Gbar^{ee} a_eta a_eta + Gbar^{xe} (a_xi a_eta + a_eta a_xi) = u a_xi + v a_eta
+/// with u = Gbar^{xx} a_xi + Gbar^{xe} a_eta, v = Gbar^{xe} a_xi + Gbar^{ee} a_eta (upper triangle stored).
+[[gnu::always_inline]] inline SymTensor left_cauchy_green(const Tangents& t, const RefMetric& g) {
+  const Vec3& a = t.a_xi;
+  const Vec3& b = t.a_eta;
+  const Vec3 u = g.g_xx * a + g.g_xe * b, v = g.g_xe * a + g.g_ee * b;
+  return {u.x * a.x + v.x * b.x, u.x * a.y + v.x * b.y, u.x * a.z + v.x * b.z,
+          u.y * a.y + v.y * b.y, u.y * a.z + v.y * b.z, u.z * a.z + v.z * b.z};
 }
 
 /// Strain invariants (19), (20) at a point with current Jacobian J.
@@ -80,10 +105,14 @@ struct Invariants {
   double A1, A2;
 };
 
-inline Invariants invariants(const Tangents& t, double J, const RefMetric& g) {
-  const double A2 = 0.5 * (g.g_xx * dot(t.a_xi, t.a_xi) + 2 * g.g_xe * dot(t.a_xi, t.a_eta) +
-                           g.g_ee * dot(t.a_eta, t.a_eta)) - 1;
-  return {std::log(J / g.J), A2};
+/// A2 (20) = tr(B)/2 - 1 = Gbar^{alpha beta} a_alpha . a_beta / 2 - 1.
+[[gnu::always_inline]] inline double second_invariant(const Tangents& t, const RefMetric& g) {
+  return 0.5 * (g.g_xx * dot(t.a_xi, t.a_xi) + 2 * g.g_xe * dot(t.a_xi, t.a_eta) + g.g_ee * dot(t.a_eta, t.a_eta)) -
+         1;
+}
+
+[[gnu::always_inline]] inline Invariants invariants(const Tangents& t, double J, const RefMetric& g) {
+  return {std::log(J / g.J), second_invariant(t, g)};
 }
 
 /// Half the difference of the squared principal stretches, (lambda1^2 - lambda2^2)/2, from the eigenvalues of
@@ -96,18 +125,20 @@ inline double principal_half_difference(const Tangents& t, const RefMetric& g) {
   return std::sqrt(std::fmax(0.0, 0.25 * (m11 - m22) * (m11 - m22) + m12 * m21));
 }
 
-/// Tension tensor (18).
-inline Mat3 tension(const EnergyDensity& w, double A1, const Mat3& B, const Vec3& n) {
-  return std::exp(-A1) * (w.dW_dA1 * (Mat3::identity() - Mat3::outer(n, n)) + w.dW_dA2 * B);
+/// Tension tensor (18), tau = e^{-A1} (dW/dA1 P + dW/dA2 B), with e^{-A1} = Jbar / J (19) given as `shrink`.
+[[gnu::always_inline]] inline SymTensor tension(const EnergyDensity& w, double shrink, const SymTensor& B, const Vec3& n) {
+  const double w1 = shrink * w.dW_dA1, w2 = shrink * w.dW_dA2;
+  return {w1 * (1 - n.x * n.x) + w2 * B.xx, w2 * B.xy - w1 * (n.x * n.y), w2 * B.xz - w1 * (n.x * n.z),
+          w1 * (1 - n.y * n.y) + w2 * B.yy, w2 * B.yz - w1 * (n.y * n.z), w1 * (1 - n.z * n.z) + w2 * B.zz};
 }
 
 /// Curvature tensor (40) from the parametric derivatives of the normal field.
-inline Mat3 curvature(const Frame& f, const Vec3& dn_dxi, const Vec3& dn_deta) {
+[[gnu::always_inline]] inline Mat3 curvature(const Frame& f, const Vec3& dn_dxi, const Vec3& dn_deta) {
   return Mat3::outer(f.d_xi, dn_dxi) + Mat3::outer(f.d_eta, dn_deta);
 }
 
 /// Surface divergence of the moment tensor, (P.grad).m = tr K with K from (41).
-inline Vec3 moment_divergence(const Frame& f, const Mat3& dm_dxi, const Mat3& dm_deta) {
+[[gnu::always_inline]] inline Vec3 moment_divergence(const Frame& f, const Mat3& dm_dxi, const Mat3& dm_deta) {
   return f.d_xi * dm_dxi + f.d_eta * dm_deta;
 }
 
@@ -116,7 +147,7 @@ struct EnergyGradient {
   Vec3 d_xi, d_eta;
 };
 
-inline EnergyGradient energy_gradient(const EnergyDensity& w, const Tangents& t, const Frame& f, const RefMetric& g) {
+[[gnu::always_inline]] inline EnergyGradient energy_gradient(const EnergyDensity& w, const Tangents& t, const Frame& f, const RefMetric& g) {
   return {w.dW_dA1 * f.d_xi + w.dW_dA2 * (g.g_xx * t.a_xi + g.g_xe * t.a_eta),
           w.dW_dA1 * f.d_eta + w.dW_dA2 * (g.g_xe * t.a_xi + g.g_ee * t.a_eta)};
 }
