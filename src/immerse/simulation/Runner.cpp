@@ -126,10 +126,18 @@ void truncate_diagnostics(const std::filesystem::path& path, long step) {
   std::ifstream in(path);
   if (!in) return;
   std::string line, kept;
-  bool header = true;
+  long number = 0;
   while (std::getline(in, line)) {
-    if (header || std::stol(line) <= step) kept += line + "\n";
-    header = false;
+    ++number;
+    if (number > 1) {
+      char* end = nullptr;
+      const long row_step = std::strtol(line.c_str(), &end, 10);
+      if (end == line.c_str() || *end != ',')
+        throw InputError("cannot continue " + path.string() + ": line " + std::to_string(number) +
+                         " is not a row of diagnostics (damaged file)");
+      if (row_step > step) continue;
+    }
+    kept += line + "\n";
   }
   io::AtomicFile::write(path, kept);
 }
@@ -169,6 +177,26 @@ class Progress {
   clock::time_point t0_, last_;
 };
 
+std::string grid_text(const io::Config& c) {
+  return "grid " + std::to_string(c.get<int>("grid.nx")) + " x " + std::to_string(c.get<int>("grid.ny")) + " x " +
+         std::to_string(c.get<int>("grid.nz"));
+}
+
+// A grid far beyond the machine's memory is refused before anything is allocated (the operating system would
+// otherwise grant the memory and kill the run when it is touched). kBytesPerCell is a lower bound: the peak
+// resident memory of a run grows by about 300 bytes per cell (16^3 -> 64^3, frames and checkpoints written).
+void check_memory(const io::Config& c) {
+  constexpr double kBytesPerCell = 250;
+  const double cells = double(c.get<int>("grid.nx")) * c.get<int>("grid.ny") * c.get<int>("grid.nz");
+  const double memory = double(sysconf(_SC_PHYS_PAGES)) * double(sysconf(_SC_PAGESIZE));
+  if (memory > 0 && cells * kBytesPerCell > memory) {
+    std::ostringstream s;
+    s << std::setprecision(3) << grid_text(c) << " = " << cells << " cells: needs at least " << cells * kBytesPerCell / 1e9
+      << " GB, this machine has " << memory / 1e9 << " GB";
+    throw InputError(s.str());
+  }
+}
+
 }  // namespace
 
 void print_config_help(std::ostream& out) { run_schema().print_help(out); }
@@ -196,20 +224,29 @@ int run_command(const RunOptions& options, std::ostream& out, std::ostream& err)
   const bool sweep_run = is_cell_scenario(config);
   if (sweep_run && !options.restart.empty())
     throw InputError("--restart: not available for rbc_stretch force sweeps (restart each force as its own run)");
-  Simulation sim(config);
+  check_memory(config);
+  std::unique_ptr<Simulation> built;
+  try {
+    built = std::make_unique<Simulation>(config);
+  } catch (const std::bad_alloc&) {
+    throw InputError(grid_text(config) + ": the fluid and membrane arrays do not fit in this machine's memory");
+  }
+  Simulation& sim = *built;
   if (!options.restart.empty()) sim.restore(io::Checkpoint::read(options.restart));
   std::unique_ptr<StretchSweep> sweep;
   if (sweep_run) sweep = std::make_unique<StretchSweep>(sim);
-  std::filesystem::create_directories(options.out);
+  std::error_code ec;
+  std::filesystem::create_directories(options.out, ec);
+  if (ec) throw WriteError("cannot write " + options.out.string() + ": " + ec.message());
   const std::filesystem::path dir = options.out;
+  const bool restarted = !options.restart.empty();
+  if (restarted) truncate_diagnostics(dir / "diagnostics.csv", sim.step());  // refuses a damaged file first
 
   out << "# immerse " << IMMERSE_VERSION << ": " << options.file.string() << " -> " << dir.string() << "\n"
       << "# resolved configuration (saved as config.resolved.toml)\n"
       << config.to_toml_string() << std::flush;
   config.save(dir / "config.resolved.toml");
 
-  const bool restarted = !options.restart.empty();
-  if (restarted) truncate_diagnostics(dir / "diagnostics.csv", sim.step());
   io::CsvWriter csv(dir / "diagnostics.csv", diagnostics_columns(sim.num_membranes(), sweep_run),
                     restarted ? io::CsvWriter::Mode::Append : io::CsvWriter::Mode::Create);
   const long fields_every = config.get<int>("output.fields_every");
@@ -217,6 +254,7 @@ int run_command(const RunOptions& options, std::ostream& out, std::ostream& err)
   if (restarted && fields_every > 0) first_frame = static_cast<int>(sim.step() / fields_every) + 1;
   io::XdmfWriter frames(dir, first_frame);
   StepRecord last;
+  long checkpoint_step = -1;  // of the last checkpoint this run wrote
 
   std::vector<Callback> callbacks{
       // A row needs the record of its step: the step that turned out unstable has none.
@@ -227,12 +265,13 @@ int run_command(const RunOptions& options, std::ostream& out, std::ostream& err)
       {"fields", fields_every, !restarted && fields_every > 0, fields_every > 0,
        [&](const Simulation& s) { write_frame(frames, s); }},
       {"checkpoint", config.get<int>("output.checkpoint_every"), false, true,
-       [&](const Simulation& s) { s.checkpoint().write(dir / "checkpoint.h5"); }},
+       [&](const Simulation& s) {
+         s.checkpoint().write(dir / "checkpoint.h5");
+         checkpoint_step = s.step();
+       }},
   };
-  for (auto& c : callbacks) {
+  for (auto& c : callbacks)
     if (restarted) c.last_step = sim.step();  // the restart step's row, frame and checkpoint already exist
-    if (c.at_start) c.run(sim, sim.step());
-  }
 
   g_stop_signal = 0;
   std::signal(SIGINT, on_signal);
@@ -250,6 +289,8 @@ int run_command(const RunOptions& options, std::ostream& out, std::ostream& err)
     if (g_stop_signal) status = 4;
   };
   try {
+    for (auto& c : callbacks)
+      if (c.at_start) c.run(sim, sim.step());
     if (sweep) {
       io::CsvWriter stretch(dir / "stretch.csv", {"force_pN", "axial_um", "transverse_um"});
       out << "rbc_stretch: " << sweep->patch_nodes() << " nodes in the two contact patches, relaxation time "
@@ -275,11 +316,21 @@ int run_command(const RunOptions& options, std::ostream& out, std::ostream& err)
     progress.finish();
     err << "immerse: run stopped: " << e.what() << "\n";
     status = 3;
+  } catch (const WriteError& e) {
+    // A full disk or a folder gone: no further write is attempted; what was written before is complete.
+    progress.finish();
+    err << "immerse: run stopped at step " << sim.step() << ", t = " << sim.time() << ": " << e.what() << " ("
+        << (checkpoint_step >= 0 ? "last checkpoint written: step " + std::to_string(checkpoint_step)
+                                 : std::string("no checkpoint written"))
+        << ")\n";
+    status = 5;
   }
   progress.finish();
-  // The last state is always saved, whatever ended the run (after an instability: the unstable state, for inspection).
-  for (auto& c : callbacks)
-    if (c.at_end && c.last_step != sim.step()) c.run(sim, sim.step());
+  // The last state is always saved, whatever ended the run (after an instability: the unstable state, for
+  // inspection), unless writing is what failed.
+  if (status != 5)
+    for (auto& c : callbacks)
+      if (c.at_end && c.last_step != sim.step()) c.run(sim, sim.step());
   if (status == 4) err << "immerse: interrupted by signal " << g_stop_signal << " at step " << sim.step() << ", t = "
                        << sim.time() << "; checkpoint written to " << (dir / "checkpoint.h5").string() << "\n";
   std::signal(SIGINT, SIG_DFL);
