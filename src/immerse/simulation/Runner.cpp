@@ -191,8 +191,8 @@ void check_memory(const io::Config& c) {
   const double memory = double(sysconf(_SC_PHYS_PAGES)) * double(sysconf(_SC_PAGESIZE));
   if (memory > 0 && cells * kBytesPerCell > memory) {
     std::ostringstream s;
-    s << std::setprecision(3) << grid_text(c) << " = " << cells << " cells: needs at least " << cells * kBytesPerCell / 1e9
-      << " GB, this machine has " << memory / 1e9 << " GB";
+    s << std::setprecision(3) << grid_text(c) << " = " << cells << " cells: needs at least "
+      << cells * kBytesPerCell / 1e9 << " GB, this machine has " << memory / 1e9 << " GB";
     throw InputError(s.str());
   }
 }
