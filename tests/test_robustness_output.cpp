@@ -122,7 +122,7 @@ TEST(RobustnessOutput, RestartRefusesADamagedDiagnosticsFileBeforeRewritingAnyth
   const auto again = run_immerse(run_args(file, out, small_membrane_sets(2), out / "checkpoint.h5"), scratch / "again");
   expect_one_error_line(again, 2, "immerse: error: ",
                         "cannot continue " + (out / "diagnostics.csv").string() +
-                            ": line 4 is not a row of diagnostics (damaged file)");
+                            ": line 4 is not a row of numbers (damaged file)");
   EXPECT_EQ(read_text(out / "diagnostics.csv"), diagnostics_before);
   EXPECT_EQ(read_text(out / "config.resolved.toml"), config_before);
 }

@@ -73,3 +73,42 @@ INSTANTIATE_TEST_SUITE_P(Run, RestartTest, ::testing::Values("jfnk", "lbfgs", "b
                          [](const auto& p) { return p.param; });
 
 }  // namespace
+
+// An rbc_stretch force sweep stopped by time.end in the middle of a force (exit 0, with a message) and continued
+// with --restart ends like the uninterrupted sweep: the same checkpoint bit for bit, the same stretch.csv and
+// diagnostics rows. dt = 2^-11 s, so that the stopping time is a whole number of steps exactly.
+TEST(RestartSweep, ForceSweepContinuesBitwiseFromAMidSweepCheckpoint) {
+  ScratchDir dir("restart_sweep");
+  auto sets = [](const std::string& end) {
+    return std::vector<std::string>{"grid.nx=16", "grid.ny=16", "grid.nz=16", "membrane[0].mesh.level=1",
+                                    "scenario.forces_pN=[0, 60]", "scenario.steady_tol=0.02",
+                                    "scenario.max_relaxation_times=2", "time.dt=4.8828125e-4", "time.end=" + end,
+                                    "output.fields_every=0", "output.checkpoint_every=0"};
+  };
+  auto run_sweep = [&](const fs::path& out, const std::string& end, const fs::path& restart = {}) {
+    std::ostringstream log, err;
+    RunOptions o;
+    o.file = scenario_file("rbc_stretch_quick.toml");
+    o.sets = sets(end);
+    o.out = out;
+    o.restart = restart;
+    EXPECT_EQ(run_command(o, log, err), 0) << err.str();
+    EXPECT_EQ(err.str(), "");
+    return log.str();
+  };
+  run_sweep(dir / "whole", "1.0");
+  const std::string first = run_sweep(dir / "split", "0.00390625");  // 8 steps: during the second force
+  EXPECT_NE(first.find("rbc_stretch: time.end reached during force 2 of 2 (60 pN)"), std::string::npos) << first;
+  EXPECT_EQ(read_csv(dir / "split" / "stretch.csv").size(), 2u);  // header and the 0 pN row
+  run_sweep(dir / "split", "1.0", dir / "split" / "checkpoint.h5");
+
+  const auto whole = io::Checkpoint::read(dir / "whole" / "checkpoint.h5");
+  const auto split = io::Checkpoint::read(dir / "split" / "checkpoint.h5");
+  EXPECT_GT(whole.get_int("step"), 8);
+  EXPECT_EQ(whole.get_int("sweep.current"), 2);  // done
+  EXPECT_TRUE(whole == split) << "checksums " << whole.checksum() << " vs " << split.checksum();
+  EXPECT_EQ(read_text(dir / "whole" / "stretch.csv"), read_text(dir / "split" / "stretch.csv"));
+  EXPECT_EQ(read_csv(dir / "whole" / "stretch.csv").size(), 3u);
+  EXPECT_EQ(without_wall_clock(read_csv(dir / "whole" / "diagnostics.csv")),
+            without_wall_clock(read_csv(dir / "split" / "diagnostics.csv")));
+}

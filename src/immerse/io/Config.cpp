@@ -16,6 +16,8 @@ Config::Config(std::shared_ptr<const ConfigSchema> schema) : schema_(std::move(s
   for (const auto& a : schema_->table_arrays()) tables_.emplace(a.name, std::vector<Config>{});
 }
 
+std::string Config::value_text(std::string_view key) const { return format_toml(value(key)); }
+
 const ConfigValue& Config::value(std::string_view key) const {
   if (const auto br = key.find('['); br != std::string_view::npos) {
     const auto close = key.find(']', br);

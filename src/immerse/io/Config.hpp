@@ -21,6 +21,9 @@ class Config {
   template <class T>
   T get(std::string_view key) const;
 
+  /// The value of a declared key as TOML text ("0.001", "\"yeoh\"", "[1.0, 2.0, 3.0]"), ready for an override.
+  std::string value_text(std::string_view key) const;
+
   /// Number of entries of the repeated table `name` ([[name]]).
   std::size_t count(std::string_view name) const;
   /// Entry i of the repeated table `name`, itself a Config of the entry schema.

@@ -49,7 +49,8 @@ ConfigSchema membrane_schema() {
 ConfigSchema run_schema() {
   ConfigSchema s;
   s.add_string("scenario.kind", "none",
-               {"none", "oscillating_membrane", "capsule_shear", "oblate_shear", "bending_shear", "rbc_stretch"},
+               {"none", "oscillating_membrane", "capsule_shear", "oblate_shear", "bending_shear", "rbc_stretch",
+                "rbc_channel"},
                "experiment whose nondimensional groups below set the dimensional values (see scenarios/README.md)");
   s.add_double("scenario.G", 0.05, Range::positive(), "capillary number G = mu k a / E_s of eq. (44) (shear scenarios)");
   s.add_double("scenario.Re", 1e-3, Range::positive(), "Reynolds number Re = rho k a^2 / mu (shear scenarios)");
@@ -57,7 +58,7 @@ ConfigSchema run_schema() {
   s.add_double("scenario.aspect_ratio", 1.0, Range::open_closed(0, 1), "oblate_shear: initial aspect ratio b/a (§4.2.2)");
   s.add_double("scenario.theta0", 0.0, Range::closed(-3.2, 3.2), "oblate_shear: initial inclination (rad)");
   s.add_double("scenario.mu0", 7.3e-6, Range::positive(),
-               "rbc_stretch: in-plane shear modulus mu0 (N/m); Yeoh law with C10 = mu0/2, C30 = mu0/30 (§4.3)");
+               "rbc_stretch, rbc_channel: in-plane shear modulus mu0 (N/m); Yeoh law with C10 = mu0/2, C30 = mu0/30 (§4.3)");
   s.add_double_list("scenario.forces_pN", {0, 20, 40, 60, 80, 100, 120, 140, 160, 180, 200}, Range::non_negative(),
                     "rbc_stretch: the stretching forces of the sweep (pN), each run to steady state");
   s.add_double("scenario.patch_um", 2.0, Range::positive(),
@@ -87,8 +88,9 @@ ConfigSchema run_schema() {
   s.add_double("fluid.rho", 1000.0, Range::positive(), "density (kg/m^3)");
   s.add_double("fluid.mu", 1e-3, Range::positive(), "dynamic viscosity (Pa s)");
   s.add_vec3("fluid.body_force", {0, 0, 0}, Range::any(), "uniform body force, a mean pressure gradient (N/m^3)");
-  s.add_string("fluid.initial", "rest", {"rest", "couette"},
-               "initial velocity: at rest, or the linear (Couette) profile between the moving walls");
+  s.add_string("fluid.initial", "rest", {"rest", "couette", "poiseuille"},
+               "initial velocity: at rest, the linear (Couette) profile between the moving walls, or the steady "
+               "flow driven by fluid.body_force between resting walls (the discrete Poiseuille solution)");
 
   s.add_string("coupling.kernel", "roma3", {"roma3", "peskin4"},
                "discrete delta: Roma-Peskin-Berger 3-point of eq. (8), or Peskin's 4-point");

@@ -9,7 +9,9 @@
 #include <cstdio>
 #include <fstream>
 #include <iomanip>
+#include <functional>
 #include <iostream>
+#include <optional>
 #include <sstream>
 
 #include "immerse/core/Error.hpp"
@@ -35,18 +37,32 @@ const std::vector<std::string> kStepColumns{"step",         "time",     "dt",   
                                             "gmres_its",    "fluid_solves", "residual", "wall_s"};
 const std::vector<std::string> kMembraneColumns{"volume", "area", "cx", "cy", "cz", "a1", "a2", "a3", "D_xz", "theta"};
 
-bool is_cell_scenario(const io::Config& c) { return c.get<std::string>("scenario.kind") == "rbc_stretch"; }
+bool is_sweep(const io::Config& c) { return c.get<std::string>("scenario.kind") == "rbc_stretch"; }
+bool is_channel(const io::Config& c) { return c.get<std::string>("scenario.kind") == "rbc_channel"; }
+bool is_cell_scenario(const io::Config& c) { return is_sweep(c) || is_channel(c); }
+// The axis along which a cell's axial diameter is measured: the force (x) or the flow (y).
+int cell_axis(const io::Config& c) { return is_channel(c) ? 1 : 0; }
 
-std::vector<std::string> diagnostics_columns(std::size_t membranes, bool cells) {
+std::vector<std::string> diagnostics_columns(const io::Config& config, std::size_t membranes) {
   auto cols = kStepColumns;
   for (std::size_t m = 0; m < membranes; ++m) {
     std::string prefix;
     if (membranes > 1) prefix.append("m").append(std::to_string(m)).append("_");
     for (const auto& c : kMembraneColumns) cols.push_back(prefix + c);
-    if (cells)
+    if (is_cell_scenario(config))
       for (const char* c : {"axial_um", "transverse_um"}) cols.push_back(prefix + c);
   }
+  if (is_channel(config)) cols.push_back("mean_velocity");
   return cols;
+}
+
+// Mean fluid velocity along the flow (y) over the box: the flow rate through a cross-section over its area
+// (on the periodic y axis every y-face is distinct, and they tile the box).
+double mean_flow_velocity(const Simulation& sim) {
+  const auto& v = sim.op().fluid_state().u[1].values();
+  double sum = 0;
+  for (double x : v) sum += x;
+  return sum / double(v.size());
 }
 
 // The principal semi-axes ordered by the coordinate axis their direction is closest to (a1 ~ x, a2 ~ y, a3 ~ z),
@@ -89,10 +105,11 @@ std::vector<double> diagnostics_row(const Simulation& sim, const StepRecord& r) 
     row.insert(row.end(), {g.volume, g.area, g.centroid.x, g.centroid.y, g.centroid.z, a[0], a[1], a[2], p.D_xz,
                            inclination(g)});
     if (is_cell_scenario(sim.config())) {
-      const CellDiameters d = cell_diameters(X);
+      const CellDiameters d = cell_diameters(X, cell_axis(sim.config()));
       row.insert(row.end(), {d.axial * 1e6, d.transverse * 1e6});
     }
   }
+  if (is_channel(sim.config())) row.push_back(mean_flow_velocity(sim));
   return row;
 }
 
@@ -121,21 +138,20 @@ void write_frame(io::XdmfWriter& writer, const Simulation& sim) {
   writer.write_frame(sim.time(), frames, sim.config().get<bool>("output.fluid_fields") ? &fluid : nullptr);
 }
 
-// Keeps the header and the rows up to `step` of a diagnostics file (a restart continues after the checkpoint).
-void truncate_diagnostics(const std::filesystem::path& path, long step) {
+// Keeps the header and the data rows r = 0, 1, ... of a CSV file for which keep(r, first number of the row) holds
+// (a restart continues after the checkpoint).
+void keep_rows(const std::filesystem::path& path, const std::function<bool(long, double)>& keep) {
   std::ifstream in(path);
   if (!in) return;
   std::string line, kept;
-  long number = 0;
-  while (std::getline(in, line)) {
-    ++number;
-    if (number > 1) {
+  for (long r = -1; std::getline(in, line); ++r) {
+    if (r >= 0) {
       char* end = nullptr;
-      const long row_step = std::strtol(line.c_str(), &end, 10);
-      if (end == line.c_str() || *end != ',')
-        throw InputError("cannot continue " + path.string() + ": line " + std::to_string(number) +
-                         " is not a row of diagnostics (damaged file)");
-      if (row_step > step) continue;
+      const double first = std::strtod(line.c_str(), &end);
+      if (end == line.c_str() || (*end != ',' && *end != '\0'))
+        throw InputError("cannot continue " + path.string() + ": line " + std::to_string(r + 2) +
+                         " is not a row of numbers (damaged file)");
+      if (!keep(r, first)) continue;
     }
     kept += line + "\n";
   }
@@ -221,9 +237,7 @@ int run_command(const RunOptions& options, std::ostream& out, std::ostream& err)
   // 1. Everything that can be wrong with the input is found before anything is written.
   const io::ConfigSchema schema = run_schema();
   const io::Config config = apply_scenario(schema.parse_file(options.file, options.sets));
-  const bool sweep_run = is_cell_scenario(config);
-  if (sweep_run && !options.restart.empty())
-    throw InputError("--restart: not available for rbc_stretch force sweeps (restart each force as its own run)");
+  const bool restarted = !options.restart.empty();
   check_memory(config);
   std::unique_ptr<Simulation> built;
   try {
@@ -232,23 +246,38 @@ int run_command(const RunOptions& options, std::ostream& out, std::ostream& err)
     throw InputError(grid_text(config) + ": the fluid and membrane arrays do not fit in this machine's memory");
   }
   Simulation& sim = *built;
-  if (!options.restart.empty()) sim.restore(io::Checkpoint::read(options.restart));
   std::unique_ptr<StretchSweep> sweep;
-  if (sweep_run) sweep = std::make_unique<StretchSweep>(sim);
+  if (is_sweep(config)) sweep = std::make_unique<StretchSweep>(sim);
+  if (restarted) {
+    const io::Checkpoint ck = io::Checkpoint::read(options.restart);
+    sim.restore(ck);
+    if (sweep) sweep->restore(ck, sim);
+  } else if (sweep) {
+    sweep->start(sim, 0);
+  }
   std::error_code ec;
   std::filesystem::create_directories(options.out, ec);
   if (ec) throw WriteError("cannot write " + options.out.string() + ": " + ec.message());
   const std::filesystem::path dir = options.out;
-  const bool restarted = !options.restart.empty();
-  if (restarted) truncate_diagnostics(dir / "diagnostics.csv", sim.step());  // refuses a damaged file first
+  // A restart continues the tables after the checkpoint (a damaged table is refused before anything is rewritten).
+  if (restarted) {
+    keep_rows(dir / "diagnostics.csv", [&](long, double step) { return step <= double(sim.step()); });
+    if (sweep) keep_rows(dir / "stretch.csv", [&](long row, double) { return row < long(sweep->current()); });
+  }
 
   out << "# immerse " << IMMERSE_VERSION << ": " << options.file.string() << " -> " << dir.string() << "\n"
       << "# resolved configuration (saved as config.resolved.toml)\n"
       << config.to_toml_string() << std::flush;
   config.save(dir / "config.resolved.toml");
 
-  io::CsvWriter csv(dir / "diagnostics.csv", diagnostics_columns(sim.num_membranes(), sweep_run),
-                    restarted ? io::CsvWriter::Mode::Append : io::CsvWriter::Mode::Create);
+  const auto mode = restarted ? io::CsvWriter::Mode::Append : io::CsvWriter::Mode::Create;
+  io::CsvWriter csv(dir / "diagnostics.csv", diagnostics_columns(config, sim.num_membranes()), mode);
+  std::optional<io::CsvWriter> stretch;
+  if (sweep) {
+    stretch.emplace(dir / "stretch.csv", std::vector<std::string>{"force_pN", "axial_um", "transverse_um"}, mode);
+    out << "rbc_stretch: " << sweep->patch_nodes() << " nodes in the two contact patches, relaxation time "
+        << sweep->relaxation_time() << " s\n";
+  }
   const long fields_every = config.get<int>("output.fields_every");
   int first_frame = 0;
   if (restarted && fields_every > 0) first_frame = static_cast<int>(sim.step() / fields_every) + 1;
@@ -266,7 +295,9 @@ int run_command(const RunOptions& options, std::ostream& out, std::ostream& err)
        [&](const Simulation& s) { write_frame(frames, s); }},
       {"checkpoint", config.get<int>("output.checkpoint_every"), false, true,
        [&](const Simulation& s) {
-         s.checkpoint().write(dir / "checkpoint.h5");
+         io::Checkpoint ck = s.checkpoint();
+         if (sweep) sweep->save(ck);
+         ck.write(dir / "checkpoint.h5");
          checkpoint_step = s.step();
        }},
   };
@@ -280,9 +311,24 @@ int run_command(const RunOptions& options, std::ostream& out, std::ostream& err)
   auto log = [&](const std::string& msg) { out << "\n" << msg << "\n"; };
   int status = 0;
   long done = 0;
+  // rbc_stretch: once the cell is steady under a force, record its diameters and apply the next force, within the
+  // step (before its callbacks), so that a checkpoint of this step already holds the next force.
+  auto sweep_update = [&] {
+    const bool steady = sweep->steady(sim);
+    if (!steady && !sweep->timed_out(sim)) return;
+    const double F = sweep->forces()[sweep->current()];
+    if (!steady)
+      log("force " + std::to_string(F * 1e12) + " pN: not steady after scenario.max_relaxation_times; recorded anyway");
+    const CellDiameters d = cell_diameters(sim.op().membrane_positions(0), 0);
+    stretch->row({F * 1e12, d.axial * 1e6, d.transverse * 1e6});
+    out << "\nforce " << F * 1e12 << " pN: axial " << d.axial * 1e6 << " um, transverse " << d.transverse * 1e6
+        << " um (t = " << sim.time() << " s)\n";
+    sweep->start(sim, sweep->current() + 1);
+  };
   auto step_once = [&] {
     last = sim.advance(log);
     ++done;
+    if (sweep) sweep_update();
     for (auto& c : callbacks)
       if (c.due(sim.step())) c.run(sim, sim.step());
     progress.update(sim, done);
@@ -291,27 +337,11 @@ int run_command(const RunOptions& options, std::ostream& out, std::ostream& err)
   try {
     for (auto& c : callbacks)
       if (c.at_start) c.run(sim, sim.step());
-    if (sweep) {
-      io::CsvWriter stretch(dir / "stretch.csv", {"force_pN", "axial_um", "transverse_um"});
-      out << "rbc_stretch: " << sweep->patch_nodes() << " nodes in the two contact patches, relaxation time "
-          << sweep->relaxation_time() << " s\n";
-      for (double F : sweep->forces()) {
-        sim.set_applied_forces(0, sweep->nodal_loads(F));
-        sweep->start(sim);
-        do step_once();
-        while (status == 0 && !sim.finished() && !sweep->steady(sim) && !sweep->timed_out(sim));
-        if (status != 0) break;
-        if (sim.finished()) throw SimulationError("time.end reached before the force sweep finished");
-        if (sweep->timed_out(sim))
-          log("force " + std::to_string(F * 1e12) + " pN: not steady after scenario.max_relaxation_times; recorded anyway");
-        const CellDiameters d = cell_diameters(sim.op().membrane_positions(0));
-        stretch.row({F * 1e12, d.axial * 1e6, d.transverse * 1e6});
-        out << "\nforce " << F * 1e12 << " pN: axial " << d.axial * 1e6 << " um, transverse " << d.transverse * 1e6
-            << " um (t = " << sim.time() << " s)\n";
-      }
-    } else {
-      while (status == 0 && !sim.finished()) step_once();
-    }
+    while (status == 0 && !sim.finished() && !(sweep && sweep->done())) step_once();
+    if (status == 0 && sweep && !sweep->done())
+      out << "\nrbc_stretch: time.end reached during force " << sweep->current() + 1 << " of " << sweep->forces().size()
+          << " (" << sweep->forces()[sweep->current()] * 1e12 << " pN); continue the sweep with --restart "
+          << (dir / "checkpoint.h5").string() << " and a later time.end\n";
   } catch (const SimulationError& e) {
     progress.finish();
     err << "immerse: run stopped: " << e.what() << "\n";

@@ -25,6 +25,22 @@ double shear_rate(const io::Config& c) {
   return c.get<double>("scenario.Re") * c.get<double>("fluid.mu") / (c.get<double>("fluid.rho") * a * a);
 }
 
+std::vector<Vec3> channel_cell_centres(const io::Config& c) {
+  const Vec3 o = c.get<Vec3>("domain.origin");
+  const double Lx = c.get<double>("domain.Lx"), Ly = c.get<double>("domain.Ly"), Lz = c.get<double>("domain.Lz");
+  std::vector<Vec3> centres;
+  for (int k = 0; k < 5; ++k)
+    for (double x : {0.25, 0.75}) centres.push_back({x * Lx, (k + 0.25) * Ly / 5, 0.18 * Lz});
+  for (int k = 0; k < 4; ++k) {
+    for (double x : {0.2, 0.8}) centres.push_back({x * Lx, (k + 0.125) * Ly / 4, 0.5 * Lz});
+    centres.push_back({0.5 * Lx, (k + 0.625) * Ly / 4, 0.5 * Lz});
+  }
+  for (int k = 0; k < 5; ++k)
+    for (double x : {0.25, 0.75}) centres.push_back({x * Lx, (k + 0.75) * Ly / 5, 0.82 * Lz});
+  for (auto& p : centres) p += o;
+  return centres;
+}
+
 namespace {
 
 // Writes the derived values into their keys; one out of range (an extreme group overflowing or underflowing) is
@@ -45,13 +61,33 @@ io::Config with_derived(const io::Config& config, const std::vector<std::string>
 // The dimensional values the scenario kind implies, written into their keys.
 io::Config derive(const io::Config& config) {
   const std::string kind = config.get<std::string>("scenario.kind");
-  if (kind == "rbc_stretch") {
-    if (config.count("membrane") != 1) throw InputError("scenario.kind = \"rbc_stretch\": needs exactly one [[membrane]]");
+  if (kind == "rbc_stretch" || kind == "rbc_channel") {
+    if (config.count("membrane") != 1)
+      throw InputError("scenario.kind = \"" + kind + "\": needs exactly one [[membrane]] (" +
+                       (kind == "rbc_channel" ? "the template of every cell" : "the cell") + "), given " +
+                       std::to_string(config.count("membrane")));
     const double mu0 = config.get<double>("scenario.mu0");
-    return with_derived(config,
-                        {"membrane[0].shape=\"rbc\"", "membrane[0].law=\"yeoh\"", "membrane[0].C10=" + num(mu0 / 2),
-                         "membrane[0].C30=" + num(mu0 / 30)},
-                        kind, "scenario.mu0");
+    io::Config derived =
+        with_derived(config,
+                     {"membrane[0].shape=\"rbc\"", "membrane[0].law=\"yeoh\"", "membrane[0].C10=" + num(mu0 / 2),
+                      "membrane[0].C30=" + num(mu0 / 30)},
+                     kind, "scenario.mu0");
+    if (kind == "rbc_stretch") return derived;
+    for (const auto& [axis, bc] : {std::pair{"x", "wall"}, {"y", "periodic"}, {"z", "wall"}})
+      require(config.get<std::string>(std::string("boundary.") + axis) == bc, std::string("boundary.") + axis,
+              std::string("\"") + bc + "\" for scenario.kind = \"rbc_channel\" (flow along the periodic y axis)");
+    const io::Config& cell = derived.entry("membrane", 0);
+    const auto centres = channel_cell_centres(config);
+    std::vector<std::string> set;
+    for (std::size_t i = 0; i < centres.size(); ++i) {
+      const std::string prefix = "membrane[" + std::to_string(i) + "].";
+      if (i > 0)
+        for (const auto& key : cell.schema().keys()) set.push_back(prefix + key.key + "=" + cell.value_text(key.key));
+      const Vec3& p = centres[i];
+      set.push_back(prefix + "center=[" + num(p.x) + "," + num(p.y) + "," + num(p.z) + "]");
+    }
+    config.schema().apply_overrides(derived, set);
+    return derived;
   }
   if (!is_shear(kind)) return config;
   if (config.count("membrane") != 1) throw InputError("scenario.kind = \"" + kind + "\": needs exactly one [[membrane]]");

@@ -10,12 +10,25 @@
 //
 // rbc_stretch (§4.3): the biconcave cell of eq. (45) with the Yeoh law (23), C10 = mu0/2 and C30 = mu0/30
 // (small-strain shear modulus mu0, notes), stretched along x (see StretchSweep).
+//
+// rbc_channel (§4.4, Fig. 15): 32 copies of the one [[membrane]] (a biconcave cell, Yeoh law as above) in a duct
+// with walls at x and z and periodic along y, the flow direction, driven by fluid.body_force (a mean pressure
+// gradient). The cells lie flat (disc in x-y) in three layers at z = 0.18 Lz, Lz/2, 0.82 Lz: the outer layers have
+// two columns at x = Lx/4, 3Lx/4 of five cells each, the middle layer three staggered columns at x = 0.2 Lx, Lx/2,
+// 0.8 Lx of four (10 + 12 + 10). In the paper's 24 x 48 x 12 um duct neighbouring cells are at least 1.2 um apart
+// and 0.88 um from the walls; Simulation checks the clearances of any other box.
+#include <vector>
+
+#include "immerse/core/Vec3.hpp"
 #include "immerse/io/Config.hpp"
 
 namespace immerse {
 
 /// The configuration with the scenario's derived values written into their keys (for printing and saving).
 io::Config apply_scenario(const io::Config& config);
+
+/// rbc_channel: the centres of the 32 cells (see above).
+std::vector<Vec3> channel_cell_centres(const io::Config& config);
 
 /// The shear rate k of a shear scenario (0 for other kinds).
 double shear_rate(const io::Config& config);

@@ -5,6 +5,7 @@
 #include <sstream>
 
 #include "immerse/core/Error.hpp"
+#include "immerse/fluid/PoiseuilleFlow.hpp"
 #include "immerse/coupling/NodeDiagnostics.hpp"
 #include "immerse/membrane/GmshReader.hpp"
 #include "immerse/membrane/MeshGenerator.hpp"
@@ -13,6 +14,7 @@
 #include "immerse/membrane/Shape.hpp"
 #include "immerse/membrane/Skalak.hpp"
 #include "immerse/membrane/Yeoh.hpp"
+#include "immerse/simulation/MembraneClearance.hpp"
 #include "immerse/timestep/DenseBfgs.hpp"
 
 namespace immerse {
@@ -161,7 +163,6 @@ void Simulation::build_membranes() {
 
 void Simulation::check_geometry() const {
   const double h = grid_.h();
-  std::vector<std::pair<Vec3, Vec3>> boxes;
   for (std::size_t m = 0; m < initial_.size(); ++m) {
     const auto& X = initial_[m];
     try {
@@ -176,21 +177,44 @@ void Simulation::check_geometry() const {
         << " m) clear for the delta function";
       throw InputError(s.str());
     }
+  }
+  if (const auto gap = closest_foreign_nodes(grid_, initial_, h)) {
+    std::ostringstream s;
+    s << membrane_name(gap->membrane_a) << " overlaps or touches " << membrane_name(gap->membrane_b) << ": its node "
+      << gap->node_a << " is " << gap->distance << " m from node " << gap->node_b << " of "
+      << membrane_name(gap->membrane_b) << ", closer than one cell (" << h << " m)";
+    throw InputError(s.str());
+  }
+  // Without close nodes two closed surfaces are apart or nested: test one node of each against the other.
+  std::vector<std::pair<Vec3, Vec3>> boxes;
+  for (const auto& X : initial_) {
     Vec3 lo = X[0], hi = X[0];
     for (const auto& p : X)
       for (int k = 0; k < 3; ++k) lo[k] = std::min(lo[k], p[k]), hi[k] = std::max(hi[k], p[k]);
-    for (std::size_t o = 0; o < boxes.size(); ++o) {
-      bool overlap = true;
-      for (int k = 0; k < 3; ++k) overlap = overlap && lo[k] < boxes[o].second[k] && boxes[o].first[k] < hi[k];
-      if (overlap) throw InputError(membrane_name(m) + " overlaps " + membrane_name(o) + " (their bounding boxes intersect)");
-    }
     boxes.emplace_back(lo, hi);
   }
+  auto nested = [&](std::size_t inner, std::size_t outer) {
+    const auto& [lo, hi] = boxes[outer];
+    const Vec3 mid = 0.5 * (lo + hi), p = mid + minimum_image(grid_, initial_[inner][0], mid);
+    for (int k = 0; k < 3; ++k)
+      if (p[k] < lo[k] || p[k] > hi[k]) return false;
+    return encloses(meshes_[outer], initial_[outer], p);
+  };
+  for (std::size_t m = 0; m < initial_.size(); ++m)
+    for (std::size_t o = 0; o < m; ++o) {
+      if (nested(m, o)) throw InputError(membrane_name(m) + " lies inside " + membrane_name(o));
+      if (nested(o, m)) throw InputError(membrane_name(o) + " lies inside " + membrane_name(m));
+    }
 }
 
 FluidState Simulation::initial_fluid_state() const {
   FluidState s = fluid_.initial_state();
-  if (config_.get<std::string>("fluid.initial") != "couette") return s;
+  const std::string initial = config_.get<std::string>("fluid.initial");
+  if (initial == "poiseuille") {
+    set_poiseuille_flow(grid_, fluid_.params(), s.u);
+    return s;
+  }
+  if (initial != "couette") return s;
   // The linear profile between the walls of the first wall axis: u = u_lower + (u_upper - u_lower) (x_a - o_a) / L_a.
   const auto& p = fluid_.params();
   int a = -1;

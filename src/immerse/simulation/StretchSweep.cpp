@@ -8,15 +8,6 @@
 
 namespace immerse {
 
-CellDiameters cell_diameters(const std::vector<Vec3>& X) {
-  double xmin = std::numeric_limits<double>::infinity(), xmax = -xmin, ymin = xmin, ymax = -xmin;
-  for (const auto& p : X) {
-    xmin = std::min(xmin, p.x), xmax = std::max(xmax, p.x);
-    ymin = std::min(ymin, p.y), ymax = std::max(ymax, p.y);
-  }
-  return {xmax - xmin, ymax - ymin};
-}
-
 StretchSweep::StretchSweep(const Simulation& sim) {
   const auto& c = sim.config();
   for (double f : c.get<std::vector<double>>("scenario.forces_pN")) forces_.push_back(f * 1e-12);
@@ -44,14 +35,38 @@ std::vector<Vec3> StretchSweep::nodal_loads(double F) const {
   return load;
 }
 
-void StretchSweep::start(const Simulation& sim) {
+void StretchSweep::start(Simulation& sim, std::size_t index) {
+  current_ = index;
+  if (done()) return;
+  sim.set_applied_forces(0, nodal_loads(forces_[index]));
   t_start_ = t_last_ = sim.time();
-  last_ = cell_diameters(sim.op().membrane_positions(0));
+  last_ = cell_diameters(sim.op().membrane_positions(0), 0);
+}
+
+void StretchSweep::save(io::Checkpoint& ck) const {
+  ck.put_int("sweep.current", static_cast<std::int64_t>(current_));
+  ck.put_double("sweep.t_start", t_start_);
+  ck.put_double("sweep.t_last", t_last_);
+  ck.put_array("sweep.last_diameters", {last_.axial, last_.transverse});
+}
+
+void StretchSweep::restore(const io::Checkpoint& ck, Simulation& sim) {
+  const auto index = ck.get_int("sweep.current");
+  if (index < 0 || static_cast<std::size_t>(index) > forces_.size())
+    throw InputError("checkpoint: force sweep position " + std::to_string(index) + " is outside scenario.forces_pN (" +
+                     std::to_string(forces_.size()) + " forces)");
+  current_ = static_cast<std::size_t>(index);
+  if (!done()) sim.set_applied_forces(0, nodal_loads(forces_[current_]));
+  t_start_ = ck.get_double("sweep.t_start");
+  t_last_ = ck.get_double("sweep.t_last");
+  const auto& d = ck.array("sweep.last_diameters");
+  if (d.size() != 2) throw InputError("checkpoint: sweep.last_diameters must hold 2 numbers");
+  last_ = {d[0], d[1]};
 }
 
 bool StretchSweep::steady(const Simulation& sim) {
   if (sim.time() - t_last_ < t_relax_) return false;
-  const CellDiameters d = cell_diameters(sim.op().membrane_positions(0));
+  const CellDiameters d = cell_diameters(sim.op().membrane_positions(0), 0);
   const bool still = std::abs(d.axial - last_.axial) <= tol_ * last_.axial &&
                      std::abs(d.transverse - last_.transverse) <= tol_ * last_.transverse;
   last_ = d;

@@ -6,18 +6,17 @@
 // until it is steady: both diameters change by less than scenario.steady_tol (relative) over one relaxation time
 //   t_relax = mu R0 / mu0
 // (fluid viscosity, cell radius, membrane shear modulus: the time in which viscous stress relaxes an elastic
-// deformation of the cell). Diameters: axial = the largest extent along x (the force axis); transverse = the
-// largest extent along y (perpendicular to the force in the plane of the disc, which lies in x-y).
+// deformation of the cell). Diameters (CellDiameters): axial = the largest extent along x (the force axis);
+// transverse = the largest extent along y (perpendicular to the force in the plane of the disc, which lies in x-y).
+// The sweep's own state (which force, since when it waits, the last diameters) goes into the run's checkpoints, so
+// that a sweep restarted from one continues bitwise identically.
 #include <vector>
 
+#include "immerse/io/Checkpoint.hpp"
+#include "immerse/membrane/CellDiameters.hpp"
 #include "immerse/simulation/Simulation.hpp"
 
 namespace immerse {
-
-struct CellDiameters {
-  double axial = 0, transverse = 0;  ///< m
-};
-CellDiameters cell_diameters(const std::vector<Vec3>& X);
 
 class StretchSweep {
  public:
@@ -34,14 +33,23 @@ class StretchSweep {
   bool steady(const Simulation& sim);
   /// True when the current force has waited max_relaxation_times without reaching a steady state.
   bool timed_out(const Simulation& sim) const;
-  /// Starts waiting for the next force at the current time.
-  void start(const Simulation& sim);
+  /// Starts force number `index` of the sweep at the current time (its loads are set on the simulation);
+  /// index = forces().size() ends the sweep.
+  void start(Simulation& sim, std::size_t index);
+  /// Index of the force being applied (forces().size() once the sweep is done).
+  std::size_t current() const { return current_; }
+  bool done() const { return current_ >= forces_.size(); }
+
+  void save(io::Checkpoint& ck) const;
+  /// Continues a sweep from a checkpoint written by save() (and re-applies that force's loads).
+  void restore(const io::Checkpoint& ck, Simulation& sim);
 
  private:
   std::vector<double> forces_;
   std::vector<std::size_t> left_, right_;
   std::size_t nodes_ = 0;
   double t_relax_ = 0, tol_ = 0, max_wait_ = 0;
+  std::size_t current_ = 0;
   double t_start_ = 0, t_last_ = 0;
   CellDiameters last_;
 };

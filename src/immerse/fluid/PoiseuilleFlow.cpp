@@ -1,0 +1,31 @@
+#include "immerse/fluid/PoiseuilleFlow.hpp"
+
+#include <algorithm>
+#include <string>
+
+#include "immerse/core/Error.hpp"
+#include "immerse/fluid/FastSolver.hpp"
+
+namespace immerse {
+
+void set_poiseuille_flow(const Grid& grid, const FluidParams& params, FaceField& u) {
+  const char* axes[3] = {"x", "y", "z"};
+  bool walls = false;
+  for (int d = 0; d < 3; ++d) {
+    if (grid.periodic(d)) continue;
+    walls = true;
+    require(params.body_force[d] == 0.0, "fluid.body_force",
+            std::string("zero along the wall axis ") + axes[d] + " for fluid.initial = \"poiseuille\"");
+    require(norm(params.wall_lower[d]) == 0.0 && norm(params.wall_upper[d]) == 0.0,
+            std::string("boundary.") + axes[d] + "_lower_velocity and _upper_velocity",
+            "zero (resting walls) for fluid.initial = \"poiseuille\"");
+  }
+  require(walls, "fluid.initial", "\"rest\" when no axis has walls (\"poiseuille\" needs walls)");
+  for (int d = 0; d < 3; ++d) {
+    auto& v = u[d].values();
+    std::fill(v.begin(), v.end(), -params.body_force[d]);
+    if (params.body_force[d] != 0.0) FastSolver(grid, velocity_layout(d), FftPlanning::Estimate).solve(u[d], 0.0, params.mu);
+  }
+}
+
+}  // namespace immerse

@@ -1,0 +1,18 @@
+#pragma once
+// Steady pressure-driven flow of the discrete equations (9)-(12): a uniform body force f (a mean pressure
+// gradient) along periodic axes, between resting no-slip walls. Each driven component solves
+//   mu lap_h u_d = -f_d,   u_d = 0 on the walls,
+// and is independent of the periodic coordinates, so u.grad_h u = 0, the pressure is uniform and u is an exact
+// steady state of the discrete Navier-Stokes step (one fast-transform solve per component). In a rectangular duct
+// it converges at second order to the series solution (study duct_poiseuille).
+#include "immerse/fluid/FluidParams.hpp"
+#include "immerse/grid/FaceField.hpp"
+#include "immerse/grid/Grid.hpp"
+
+namespace immerse {
+
+/// Overwrites u with the discrete Poiseuille flow of params.body_force. InputError (naming fluid.body_force,
+/// boundary.*_velocity or fluid.initial) unless there is a wall axis, all walls rest and f is zero along wall axes.
+void set_poiseuille_flow(const Grid& grid, const FluidParams& params, FaceField& u);
+
+}  // namespace immerse

@@ -1,0 +1,75 @@
+// The rbc_channel scenario (§4.4, Fig. 15) on a coarse grid: 32 cells where Scenario.hpp says, every cell's
+// columns and mean_velocity in diagnostics.csv, the fluid starting in the discrete Poiseuille flow of the duct
+// (mean velocity = the series value up to O(h^2)), and the checks of its boundary layout.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "immerse/fluid/ExactSolutions.hpp"
+#include "immerse/io/ConfigSchema.hpp"
+#include "immerse/simulation/RunSchema.hpp"
+#include "immerse/simulation/Scenario.hpp"
+#include "test_run_support.hpp"
+
+using namespace immerse;
+using namespace immerse::testing;
+
+namespace {
+
+const std::vector<std::string> kCoarse{"grid.nx=32",          "grid.ny=64",           "grid.nz=16",
+                                       "membrane[0].mesh.level=0", "time.end=9e-4", "output.fields_every=0"};
+
+TEST(RbcChannel, ThirtyTwoCellsInAPoiseuilleDuctWithTheirDiagnostics) {
+  ScratchDir dir("channel");
+  const auto r = run_immerse(run_args(scenario_file("rbc_channel_quick.toml"), dir / "out", kCoarse), dir / "log");
+  ASSERT_EQ(r.status, 0) << r.err;
+  const auto rows = read_csv(dir / "out" / "diagnostics.csv");
+  ASSERT_EQ(rows.size(), 4u);  // header, steps 0, 1, 2
+  const auto& head = rows[0];
+  EXPECT_EQ(head.back(), "mean_velocity");
+  EXPECT_EQ(head.size(), 8u + 32u * 12u + 1u);
+  auto column = [&](const std::string& name) {
+    const auto it = std::find(head.begin(), head.end(), name);
+    EXPECT_NE(it, head.end()) << name;
+    return static_cast<std::size_t>(it - head.begin());
+  };
+
+  const auto config = apply_scenario(run_schema().parse_file(scenario_file("rbc_channel_quick.toml"), kCoarse));
+  ASSERT_EQ(config.count("membrane"), 32u);
+  const auto centres = channel_cell_centres(config);
+  // Cell m's column `what` ("m7_cx"), built with += (GCC 12 warns falsely on chained string + at -O3).
+  auto cell = [&](std::size_t m, const char* what) {
+    std::string name = "m";
+    name += std::to_string(m);
+    name += '_';
+    name += what;
+    return column(name);
+  };
+  for (std::size_t m = 0; m < 32; ++m) {
+    EXPECT_NEAR(std::stod(rows[1][cell(m, "cx")]), centres[m].x, 1e-12);
+    EXPECT_NEAR(std::stod(rows[1][cell(m, "cy")]), centres[m].y, 1e-12);
+    EXPECT_NEAR(std::stod(rows[1][cell(m, "cz")]), centres[m].z, 1e-12);
+    EXPECT_NEAR(std::stod(rows[1][cell(m, "axial_um")]), 7.82, 1e-9);  // along the flow: the disc's diameter
+    EXPECT_EQ(config.entry("membrane", m).get<double>("C10"), 5e-6);      // mu0/2 for every cell
+  }
+  // Step 0: the cell-free discrete Poiseuille flow, mean velocity = Q / (Lx Lz) of the series (2:1 duct).
+  const DuctPoiseuille series{12e-6, 6e-6, 9e4, 4.1e-3};
+  const double mean0 = std::stod(rows[1][column("mean_velocity")]), exact = series.flow_rate() / (24e-6 * 12e-6);
+  EXPECT_NEAR(mean0 / exact, 1.0, 0.02) << mean0 << " vs " << exact;
+  // The cells are carried downstream (+y) and add dissipation: the mean flow slows.
+  EXPECT_GT(std::stod(rows[3][cell(12, "cy")]), centres[12].y);
+  EXPECT_LT(std::stod(rows[3][column("mean_velocity")]), mean0);
+}
+
+TEST(RbcChannel, NeedsWallsAtXAndZAndAPeriodicY) {
+  ScratchDir dir("channel_bad");
+  auto sets = kCoarse;
+  sets.push_back("boundary.y=\"wall\"");
+  const auto r = run_immerse(run_args(scenario_file("rbc_channel_quick.toml"), dir / "out", sets), dir / "log");
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.err.find("boundary.y"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("\"periodic\" for scenario.kind = \"rbc_channel\""), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(dir / "out"));
+}
+
+}  // namespace
