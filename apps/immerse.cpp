@@ -54,7 +54,9 @@ int main(int argc, char** argv) {
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
-    return app.exit(e) == 0 ? 0 : 2;
+    if (e.get_exit_code() == 0) return app.exit(e);  // --help, --version
+    std::cerr << "immerse: error: " << e.what() << " (see immerse --help)\n";
+    return 2;
   }
   try {
     if (*scenarios) {

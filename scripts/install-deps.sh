@@ -5,7 +5,8 @@ pkgs=(cmake g++ make pkg-config
       libfftw3-dev libhdf5-dev libtomlplusplus-dev libcli11-dev
       petsc-dev
       libgtest-dev libgmock-dev libbenchmark-dev
-      python3 python3-matplotlib python3-numpy python3-h5py)
+      python3 python3-matplotlib python3-numpy python3-h5py
+      clang libclang-rt-14-dev libomp-14-dev)  # the last three: scripts/fuzz.sh (libFuzzer, cmake --preset fuzz)
 missing=()
 for p in "${pkgs[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

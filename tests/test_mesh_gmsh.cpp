@@ -1,5 +1,6 @@
 // Gmsh reader and closed-mesh validation: hand-written .msh files for each supported form and each defect.
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <cmath>
 #include <filesystem>
@@ -55,9 +56,14 @@ std::string quadratic_v2(const Mesh& m) {
   return s.str();
 }
 
+/// A temporary file name of this process (ctest runs tests of this program in parallel processes).
+std::filesystem::path temp_path(const std::string& name) {
+  return std::filesystem::temp_directory_path() / ("immerse_test_" + std::to_string(getpid()) + "_" + name);
+}
+
 /// Writes `text` to a temporary .msh file and reads it back.
 Mesh read_text(const std::string& text, const std::string& name = "cell.msh") {
-  const auto path = std::filesystem::temp_directory_path() / ("immerse_test_" + name);
+  const auto path = temp_path(name);
   std::ofstream(path) << text;
   Mesh m = read_gmsh(path.string());
   std::filesystem::remove(path);
@@ -157,7 +163,7 @@ TEST(GmshReader, RejectsAZeroAreaElement) {
   // Node 5 moved onto the segment between nodes 1 and 3: face (1, 3, 5) collapses.
   const std::string coords = "1 1 0 0\n2 -1 0 0\n3 0 1 0\n4 0 -1 0\n5 0.5 0.5 0\n6 0 0 -1\n";
   EXPECT_EQ(error_of(octahedron_v2(kOctFaces, coords)), "mesh " +
-            (std::filesystem::temp_directory_path() / "immerse_test_cell.msh").string() +
+            temp_path("cell.msh").string() +
             ": element 0 (gmsh id 101) has zero area");
 }
 

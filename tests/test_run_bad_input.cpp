@@ -2,6 +2,7 @@
 // the value given and what is allowed, before anything is written (the --out folder is not even created).
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstring>
 
 #include "immerse/io/Checkpoint.hpp"
@@ -14,14 +15,47 @@ using namespace immerse::testing;
 namespace {
 
 struct BadInput {
+  BadInput(std::string n, std::string f, std::vector<std::string> s, std::string r, std::string m,
+           std::vector<std::string> a = {})
+      : name(std::move(n)), file(std::move(f)), sets(std::move(s)), restart(std::move(r)), message(std::move(m)),
+        args(std::move(a)) {}
   std::string name;
   std::string file;               ///< a file of the suite folder, or "" for oscillating_membrane_quick.toml
   std::vector<std::string> sets;  ///< added to small_membrane_sets(1)
   std::string restart;            ///< a checkpoint of the suite folder, or ""
   std::string message;            ///< expected in the one line on stderr
+  std::vector<std::string> args;  ///< further command-line arguments
 };
 
 void PrintTo(const BadInput& b, std::ostream* os) { *os << b.name; }
+
+/// The octahedron seed of the mesh fuzzing corpus (6-node triangles, Gmsh 2.2) scaled to `radius`, as lines.
+std::vector<std::string> octahedron_lines(double radius) {
+  std::ifstream in(fs::path(IMMERSE_SOURCE_DIR) / "fuzz" / "corpus" / "mesh" / "octahedron_v22_6node.msh");
+  std::vector<std::string> lines;
+  bool in_nodes = false;
+  for (std::string line; std::getline(in, line);) {
+    if (line == "$EndNodes") in_nodes = false;
+    if (in_nodes && line.find(' ') != std::string::npos) {
+      std::istringstream l(line);
+      long tag = 0;
+      double x = 0, y = 0, z = 0;
+      l >> tag >> x >> y >> z;
+      std::ostringstream scaled;
+      scaled.precision(17);
+      scaled << tag << " " << radius * x << " " << radius * y << " " << radius * z;
+      line = scaled.str();
+    }
+    if (line == "$Nodes") in_nodes = true;
+    lines.push_back(line);
+  }
+  return lines;
+}
+
+void write_lines(const fs::path& path, const std::vector<std::string>& lines) {
+  std::ofstream f(path);
+  for (const auto& l : lines) f << l << "\n";
+}
 
 class BadInputTest : public ::testing::TestWithParam<BadInput> {
  public:
@@ -32,8 +66,9 @@ class BadInputTest : public ::testing::TestWithParam<BadInput> {
     const fs::path dir = suite_dir();
     fs::remove_all(dir);
     fs::create_directories(dir);
-    const auto r = run_immerse(run_args(scenario_file("oscillating_membrane_quick.toml"), dir / "good",
-                                        small_membrane_sets(1)),
+    auto good_sets = small_membrane_sets(1);
+    good_sets.push_back("output.fields_every=1");  // a frame file, to be offered as a checkpoint
+    const auto r = run_immerse(run_args(scenario_file("oscillating_membrane_quick.toml"), dir / "good", good_sets),
                                dir / "good_run");
     ASSERT_EQ(r.status, 0) << r.err;
     const fs::path ck = dir / "good" / "checkpoint.h5";
@@ -53,6 +88,21 @@ class BadInputTest : public ::testing::TestWithParam<BadInput> {
     const std::string base = read_text(scenario_file("oscillating_membrane_quick.toml"));
     std::ofstream(dir / "two_membranes.toml") << base << "\n" << base.substr(base.find("[[membrane]]"));
     std::ofstream(dir / "syntax_error.toml") << "[fluid]\nmu = = 1\n";
+
+    // The octahedron of radius 0.2 cut before its fifth element, and with the mid-side node of the first element's
+    // first edge (Gmsh node 7) mirrored through the centre, so that the curved elements on that edge fold back.
+    auto oct = octahedron_lines(0.2);
+    const auto fifth = std::find_if(oct.begin(), oct.end(), [](const std::string& l) { return l.rfind("5 9 ", 0) == 0; });
+    write_lines(dir / "truncated.msh", std::vector<std::string>(oct.begin(), fifth));
+    auto seven = std::find_if(oct.begin(), oct.end(), [](const std::string& l) { return l.rfind("7 ", 0) == 0; });
+    std::istringstream node(*seven);
+    double tag = 0, x = 0, y = 0, z = 0;
+    node >> tag >> x >> y >> z;
+    std::ostringstream mirrored;
+    mirrored.precision(17);
+    mirrored << "7 " << -x << " " << -y << " " << -z;
+    *seven = mirrored.str();
+    write_lines(dir / "inverted.msh", oct);
   }
   static void TearDownTestSuite() { fs::remove_all(suite_dir()); }
 };
@@ -63,9 +113,13 @@ TEST_P(BadInputTest, ExitsWithStatus2AndOneLineBeforeWritingAnything) {
   const fs::path out = scratch / "out";
   const fs::path file = b.file.empty() ? scenario_file("oscillating_membrane_quick.toml") : suite_dir() / b.file;
   auto sets = small_membrane_sets(1);
-  sets.insert(sets.end(), b.sets.begin(), b.sets.end());
-  const auto r = run_immerse(run_args(file, out, sets, b.restart.empty() ? fs::path{} : suite_dir() / b.restart),
-                             scratch / "run");
+  for (std::string set : b.sets) {
+    if (const auto at = set.find("SUITE"); at != std::string::npos) set.replace(at, 5, suite_dir().string());
+    sets.push_back(set);
+  }
+  auto args = run_args(file, out, sets, b.restart.empty() ? fs::path{} : suite_dir() / b.restart);
+  args.insert(args.end(), b.args.begin(), b.args.end());
+  const auto r = run_immerse(args, scratch / "run");
   EXPECT_EQ(r.status, 2) << r.err;
   EXPECT_EQ(r.err.rfind("immerse: error: ", 0), 0u) << r.err;
   EXPECT_NE(r.err.find(b.message), std::string::npos) << "expected: " << b.message << "\ngot: " << r.err;
@@ -105,7 +159,53 @@ INSTANTIATE_TEST_SUITE_P(
                  "'[grid] nx = 8'"},
         BadInput{"corrupted_checkpoint", "", {}, "flipped.h5", "flipped.h5 is corrupted: checksum mismatch"},
         BadInput{"truncated_checkpoint", "", {}, "truncated.h5", "truncated.h5 is truncated or not an HDF5 file"},
-        BadInput{"missing_checkpoint", "", {}, "no_such_checkpoint.h5", "no_such_checkpoint.h5"}),
+        BadInput{"missing_checkpoint", "", {}, "no_such_checkpoint.h5", "no_such_checkpoint.h5"},
+        // docs/robustness.md: the hand-tried table.
+        BadInput{"boolean_for_a_number", "", {"fluid.mu=true"}, "", "fluid.mu = true: must be a finite number > 0"},
+        BadInput{"config_is_a_folder", "good", {}, "", "good: cannot read: Is a directory"},
+        BadInput{"infinite_viscosity", "", {"fluid.mu=inf"}, "", "fluid.mu = inf: must be a finite number > 0"},
+        BadInput{"zero_density", "", {"fluid.rho=0"}, "", "fluid.rho = 0: must be a finite number > 0"},
+        BadInput{"zero_modulus", "", {"membrane[0].Es=0"}, "", "membrane[0].Es = 0: must be a finite number > 0"},
+        BadInput{"negative_modulus", "", {"membrane[0].Es=-0.1"}, "",
+                 "membrane[0].Es = -0.1: must be a finite number > 0"},
+        BadInput{"zero_time_step", "", {"time.dt=0"}, "", "time.dt = 0: must be a finite number > 0"},
+        BadInput{"overflowing_time_step", "", {"time.dt=1e400"}, "", "time.dt = 1e400: must be a finite number > 0"},
+        BadInput{"step_longer_than_run", "", {"time.dt=2"}, "",
+                 "time.dt = 2: must be <= time.end = 0.125 (one step is longer than the run)"},
+        BadInput{"step_floor_above_step", "", {"time.dt_min=1"}, "", "time.dt_min = 1: must be in (0, time.dt]"},
+        BadInput{"zero_cells", "", {"grid.nx=0"}, "", "grid.nx = 0: must be an integer >= 2"},
+        BadInput{"fractional_cells", "", {"grid.nx=16.5"}, "", "grid.nx = 16.5: must be an integer >= 2"},
+        BadInput{"cells_beyond_32_bits", "", {"grid.nx=3000000000"}, "", "grid.nx = 3000000000: must be a 32-bit integer"},
+        BadInput{"grid_beyond_memory", "", {"grid.nx=100000", "grid.ny=100000", "grid.nz=100000"}, "",
+                 "grid 100000 x 100000 x 100000 = 1e+15 cells: needs at least"},
+        BadInput{"two_numbers_for_a_point", "", {"membrane[0].center=[0.5,0.5]"}, "",
+                 "membrane[0].center = [0.5,0.5]: must be 3 finite numbers [x, y, z]"},
+        BadInput{"nan_semi_axis", "", {"membrane[0].semi_axes=[0.25,0.22,nan]"}, "",
+                 "membrane[0].semi_axes = [0.25,0.22,nan]: must be 3 finite numbers [x, y, z], each > 0"},
+        BadInput{"zero_rotation_axis", "", {"membrane[0].rotation_axis=[0,0,0]", "membrane[0].rotation_angle=1"}, "",
+                 "membrane[0].rotation_axis: must be a non-zero vector"},
+        BadInput{"mesh_level_too_fine", "", {"membrane[0].mesh.level=8"}, "",
+                 "membrane[0].mesh.level = 8: must be an integer in [0, 7]"},
+        BadInput{"membrane_index_gap", "", {"membrane[2].Es=1"}, "", "membrane[2].Es: index 2 given: must be in [0, 1]"},
+        BadInput{"missing_mesh_file_key", "", {"membrane[0].mesh.family=\"file\""}, "",
+                 "membrane[0].mesh.file: must be a Gmsh file name when mesh.family = \"file\""},
+        BadInput{"shear_without_walls", "", {"scenario.kind=\"capsule_shear\"", "boundary.z=\"periodic\""}, "",
+                 "boundary.z: must be \"wall\" for scenario.kind = \"capsule_shear\""},
+        BadInput{"derived_modulus_overflows", "", {"scenario.kind=\"capsule_shear\"", "scenario.G=1e-320"}, "",
+                 "scenario.kind = \"capsule_shear\" derives membrane[0].Es = inf: must be a finite number > 0"},
+        BadInput{"truncated_mesh", "",
+                 {"membrane[0].mesh.family=\"file\"", "membrane[0].mesh.file=\"SUITE/truncated.msh\""}, "",
+                 "truncated.msh: truncated or malformed file while reading $Elements"},
+        BadInput{"inverted_mesh_element", "",
+                 {"membrane[0].mesh.family=\"file\"", "membrane[0].mesh.file=\"SUITE/inverted.msh\""}, "",
+                 "inverted.msh: element 0 (gmsh id 1) is inverted"},
+        BadInput{"mesh_file_is_a_folder", "",
+                 {"membrane[0].mesh.family=\"file\"", "membrane[0].mesh.file=\"SUITE\""}, "",
+                 "cannot open the file: it is a directory"},
+        BadInput{"frame_offered_as_checkpoint", "", {}, "good/fields_000000.h5",
+                 "fields_000000.h5 is not an immerse checkpoint (no format version)"},
+        BadInput{"unknown_option", "", {}, "", "The following argument was not expected: --sett (see immerse --help)",
+                 {"--sett"}}),
     [](const auto& p) { return p.param.name; });
 
 }  // namespace
@@ -149,4 +249,16 @@ TEST(BadInputRestart, ChangedMeshFileIsRefused) {
   EXPECT_EQ(again.status, 2) << again.err;
   EXPECT_NE(again.err.find("the reference state of membrane[0] differs"), std::string::npos) << again.err;
   fs::remove_all(dir);
+}
+
+// A shear scenario whose [[membrane]] table is missing (run as it is: the small-run overrides would add one).
+TEST(BadInputMissing, ShearScenarioWithoutItsMembraneTable) {
+  ScratchDir scratch("bad_input");
+  const std::string shear = read_text(scenario_file("capsule_shear_quick.toml"));
+  std::ofstream(scratch / "no_membrane.toml") << shear.substr(0, shear.find("[[membrane]]"));
+  const fs::path out = scratch / "out";
+  const auto r = run_immerse({"run", (scratch / "no_membrane.toml").string(), "--out", out.string()}, scratch / "run");
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_EQ(r.err, "immerse: error: scenario.kind = \"capsule_shear\": needs exactly one [[membrane]]\n");
+  EXPECT_FALSE(fs::exists(out));
 }

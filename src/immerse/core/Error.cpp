@@ -4,6 +4,16 @@
 
 namespace immerse {
 
+namespace {
+std::string one_line(std::string s) {
+  for (char& c : s)
+    if (c == '\n' || c == '\r') c = ' ';
+  return s;
+}
+}  // namespace
+
+InputError::InputError(const std::string& what) : std::runtime_error(one_line(what)) {}
+
 void require(bool ok, const std::string& name, double value, const std::string& allowed) {
   if (ok) return;
   std::ostringstream s;

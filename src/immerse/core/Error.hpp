@@ -9,7 +9,16 @@ namespace immerse {
 /// Bad user input (configuration, mesh, parameters, command line). Exit code 2.
 class InputError : public std::runtime_error {
  public:
-  using std::runtime_error::runtime_error;
+  /// Line breaks in `what` (a quoted key, a file name or a value as given) become spaces: the message is one line.
+  explicit InputError(const std::string& what);
+};
+
+/// A file that cannot be written (a missing or unwritable folder, a full disk): "cannot write <path>: <reason>".
+/// Before a run starts it is bad input (exit 2); during a run it stops the run (exit 5), the files written
+/// before it being complete (every write is atomic).
+class WriteError : public InputError {
+ public:
+  using InputError::InputError;
 };
 
 /// A simulation that cannot go on (instability, inverted element, non-finite values).

@@ -37,7 +37,7 @@ void AtomicFile::fail(int err) { fail(std::strerror(err)); }
 void AtomicFile::fail(const std::string& why) {
   ::unlink(temp_.c_str());
   committed_ = true;  // nothing left to clean up
-  throw InputError("cannot write " + path_.string() + ": " + why);
+  throw WriteError("cannot write " + path_.string() + ": " + why);
 }
 
 void AtomicFile::commit() {

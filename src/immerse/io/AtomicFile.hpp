@@ -1,7 +1,7 @@
 #pragma once
 // Atomic file replacement: the content goes to "<name>.tmp.<pid>" in the same directory, is fsync'ed and then
 // renamed over <name>, so readers see either the old file or the complete new one, never a partial file.
-// On any failure the temporary is removed and an InputError "cannot write <path>: <errno text>" is thrown.
+// On any failure the temporary is removed and a WriteError "cannot write <path>: <errno text>" is thrown.
 #include <filesystem>
 #include <string>
 #include <string_view>

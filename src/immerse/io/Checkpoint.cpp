@@ -143,14 +143,13 @@ bool Checkpoint::operator==(const Checkpoint& o) const {
 }
 
 void Checkpoint::write(const std::filesystem::path& path) const {
-  AtomicFile out(path);
-  hdf5::Quiet quiet;
-  errno = 0;
-  hdf5::Handle file = hdf5::create_file(out.temp_path());
-  if (!file.valid()) out.fail(errno ? errno : EIO);
+  // Built in memory, then written atomically in one piece (see hdf5::create_memory_file).
   const auto check = [&](bool ok, const std::string& what) {
-    if (!ok) out.fail("HDF5 error writing " + what);
+    if (!ok) throw WriteError("cannot write " + path.string() + ": HDF5 error writing " + what);
   };
+  hdf5::Quiet quiet;
+  hdf5::Handle file = hdf5::create_memory_file(path.string());
+  check(file.valid(), "the file");
   const hid_t root = file.get();
   check(hdf5::write_attribute(root, kVersionAttr, kFormatVersion), "format version");
   check(hdf5::write_attribute(root, kChecksumAttr, checksum()), "checksum");
@@ -169,9 +168,10 @@ void Checkpoint::write(const std::filesystem::path& path) const {
   for (const auto& [name, v] : doubles_) check(hdf5::write_doubles(doubles.get(), name, &v, {}), "double/" + name);
   for (const auto& [name, v] : strings_) check(hdf5::write_string(strings.get(), name, v), "string/" + name);
   check(arrays.close() && ints.close() && doubles.close() && strings.close(), "groups");
-  errno = 0;
-  if (!file.close()) out.fail(errno ? std::string(std::strerror(errno)) : "HDF5 error closing the file");
-  out.commit();
+  std::string image;
+  check(hdf5::file_image(file.get(), image), "the file image");
+  check(file.close(), "the file image");
+  AtomicFile::write(path, image);
 }
 
 Checkpoint Checkpoint::read(const std::filesystem::path& path) {

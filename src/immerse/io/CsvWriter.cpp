@@ -23,7 +23,7 @@ std::string header_line(const std::vector<std::string>& columns) {
 }
 
 [[noreturn]] void cannot_write(const std::filesystem::path& p, int err) {
-  throw InputError("cannot write " + p.string() + ": " + std::strerror(err));
+  throw WriteError("cannot write " + p.string() + ": " + std::strerror(err));
 }
 
 }  // namespace

@@ -26,10 +26,68 @@ Quiet::Quiet() {
 
 Quiet::~Quiet() { H5Eset_auto2(H5E_DEFAULT, func_, data_); }
 
-Handle create_file(const std::string& path) {
+Handle create_memory_file(const std::string& name) {
   Handle fapl(H5Pcreate(H5P_FILE_ACCESS), H5Pclose);
-  if (!fapl.valid() || H5Pset_libver_bounds(fapl.get(), H5F_LIBVER_V18, H5F_LIBVER_LATEST) < 0) return {};
-  return {H5Fcreate(path.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, fapl.get()), H5Fclose};
+  if (!fapl.valid() || H5Pset_libver_bounds(fapl.get(), H5F_LIBVER_V18, H5F_LIBVER_LATEST) < 0 ||
+      H5Pset_fapl_core(fapl.get(), 1 << 20, false) < 0)
+    return {};
+  return {H5Fcreate(name.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, fapl.get()), H5Fclose};
+}
+
+namespace {
+
+// Bob Jenkins' lookup3 hash (hashlittle, public domain), which HDF5 uses for its metadata checksums.
+std::uint32_t rot(std::uint32_t x, int k) { return (x << k) | (x >> (32 - k)); }
+
+std::uint32_t lookup3(const unsigned char* k, std::size_t length, std::uint32_t initval) {
+  std::uint32_t a = 0xdeadbeef + static_cast<std::uint32_t>(length) + initval, b = a, c = a;
+  const auto word = [&](int i) {
+    return std::uint32_t(k[i]) | std::uint32_t(k[i + 1]) << 8 | std::uint32_t(k[i + 2]) << 16 |
+           std::uint32_t(k[i + 3]) << 24;
+  };
+  while (length > 12) {
+    a += word(0), b += word(4), c += word(8);
+    a -= c, a ^= rot(c, 4), c += b;
+    b -= a, b ^= rot(a, 6), a += c;
+    c -= b, c ^= rot(b, 8), b += a;
+    a -= c, a ^= rot(c, 16), c += b;
+    b -= a, b ^= rot(a, 19), a += c;
+    c -= b, c ^= rot(b, 4), b += a;
+    length -= 12, k += 12;
+  }
+  if (length == 0) return c;
+  std::uint32_t tail[3] = {0, 0, 0};
+  for (std::size_t i = 0; i < length; ++i) tail[i / 4] |= std::uint32_t(k[i]) << (8 * (i % 4));
+  a += tail[0], b += tail[1], c += tail[2];
+  c ^= b, c -= rot(b, 14);
+  a ^= c, a -= rot(c, 11);
+  b ^= a, b -= rot(a, 25);
+  c ^= b, c -= rot(b, 16);
+  a ^= c, a -= rot(c, 4);
+  b ^= a, b -= rot(a, 14);
+  c ^= b, c -= rot(b, 24);
+  return c;
+}
+
+}  // namespace
+
+bool file_image(hid_t file, std::string& bytes) {
+  if (H5Fflush(file, H5F_SCOPE_GLOBAL) < 0) return false;
+  const ssize_t n = H5Fget_file_image(file, nullptr, 0);
+  if (n <= 0) return false;
+  bytes.assign(static_cast<std::size_t>(n), '\0');
+  if (H5Fget_file_image(file, bytes.data(), bytes.size()) != n) return false;
+  // HDF5 1.10 clears the superblock's "open for writing" flags in the image without recomputing the superblock
+  // checksum (versions 2 and 3), which makes the image unreadable; recompute it. The superblock: signature (8),
+  // version, size of offsets, size of lengths, flags (1 each), four addresses, then the checksum.
+  auto* b = reinterpret_cast<unsigned char*>(bytes.data());
+  if (bytes.size() >= 12 && b[8] >= 2) {
+    const std::size_t at = 12 + 4 * std::size_t(b[9]);
+    if (bytes.size() < at + 4) return false;
+    const std::uint32_t sum = lookup3(b, at, 0);
+    for (int i = 0; i < 4; ++i) b[at + i] = static_cast<unsigned char>(sum >> (8 * i));
+  }
+  return true;
 }
 
 Handle open_file_readonly(const std::string& path) {

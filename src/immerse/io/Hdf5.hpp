@@ -44,8 +44,12 @@ class Quiet {
   void* data_ = nullptr;
 };
 
-/// Creates a new file (truncating), with checksummed (1.8+) metadata.
-Handle create_file(const std::string& path);
+/// Creates a new file in memory only (HDF5's core driver without backing store; `name` identifies it), with
+/// checksummed (1.8+) metadata. Its bytes are then taken with file_image and written by the caller (atomically,
+/// with the operating system's own error on a full disk: HDF5 never writes to, or fails on, the disk itself).
+Handle create_memory_file(const std::string& name);
+/// The complete bytes of an open file (flushed first).
+bool file_image(hid_t file, std::string& bytes);
 Handle open_file_readonly(const std::string& path);
 Handle create_group(hid_t loc, const std::string& name);
 Handle open_group(hid_t loc, const std::string& name);

@@ -59,7 +59,7 @@ std::string XdmfWriter::frame_file_name(int frame) {
 XdmfWriter::XdmfWriter(std::filesystem::path dir, int first_frame) : dir_(std::move(dir)) {
   std::error_code ec;
   std::filesystem::create_directories(dir_, ec);
-  if (ec) throw InputError("cannot write " + dir_.string() + ": " + ec.message());
+  if (ec) throw WriteError("cannot write " + dir_.string() + ": " + ec.message());
   hdf5::Quiet quiet;
   for (int f = 0; f < first_frame; ++f) {
     const std::filesystem::path p = dir_ / frame_file_name(f);
@@ -83,14 +83,13 @@ std::filesystem::path XdmfWriter::write_frame(double time, std::span<const Surfa
   char tag[16];
   std::snprintf(tag, sizeof tag, "%06d", frame);
 
-  AtomicFile out(path);
-  hdf5::Quiet quiet;
-  errno = 0;
-  hdf5::Handle file = hdf5::create_file(out.temp_path());
-  if (!file.valid()) out.fail(errno ? errno : EIO);
+  // Built in memory, then written atomically in one piece (see hdf5::create_memory_file).
   const auto check = [&](bool ok, const std::string& what) {
-    if (!ok) out.fail("HDF5 error writing " + what);
+    if (!ok) throw WriteError("cannot write " + path.string() + ": HDF5 error writing " + what);
   };
+  hdf5::Quiet quiet;
+  hdf5::Handle file = hdf5::create_memory_file(path.string());
+  check(file.valid(), "the file");
   check(hdf5::write_attribute(file.get(), "time", time), "time");
 
   // Membranes: one spatial collection per frame.
@@ -173,9 +172,10 @@ std::filesystem::path XdmfWriter::write_frame(double time, std::span<const Surfa
   }
   check(hdf5::write_attribute(file.get(), kMembraneAttr, mx) && hdf5::write_attribute(file.get(), kFluidAttr, fx),
         "XDMF fragments");
-  errno = 0;
-  if (!file.close()) out.fail(errno ? std::string(std::strerror(errno)) : "HDF5 error closing the file");
-  out.commit();
+  std::string image;
+  check(hdf5::file_image(file.get(), image), "the file image");
+  check(file.close(), "the file image");
+  AtomicFile::write(path, image);
 
   membrane_xml_.push_back(std::move(mx));
   fluid_xml_.push_back(std::move(fx));

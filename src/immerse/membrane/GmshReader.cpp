@@ -1,7 +1,11 @@
 #include "immerse/membrane/GmshReader.hpp"
 
 #include <algorithm>
+#include <cerrno>
+#include <cstring>
+#include <filesystem>
 #include <cstdint>
+#include <cstdlib>
 #include <fstream>
 #include <limits>
 #include <unordered_map>
@@ -77,6 +81,13 @@ class Parser {
     return v;
   }
 
+  // A count or an id: a non-negative integer (reading "-1" into an unsigned type would wrap it to 2^64 - 1).
+  std::size_t whole(const char* what) {
+    const auto v = next<long long>(what);
+    if (v < 0) fail(std::string(what) + ": " + std::to_string(v) + " given, must be a non-negative integer");
+    return static_cast<std::size_t>(v);
+  }
+
   void expect_end(const std::string& end) {
     std::string word;
     if (!(in_ >> word) || word != end)
@@ -108,18 +119,15 @@ class Parser {
     node_tags_.push_back(tag);
   }
 
-  // Reads one coordinate; "nan" and "inf" are read as such so that validation can name the node.
+  // Reads one coordinate; "nan" and "inf" are read as such, and so is a value beyond the double range (overflow:
+  // infinite, underflow: zero or subnormal), so that validation can name the node.
   double coordinate(std::size_t tag) {
     const auto s = next<std::string>("node coordinates");
-    try {
-      std::size_t used = 0;
-      const double v = std::stod(s, &used);
-      if (used == s.size()) return v;
-    } catch (const std::out_of_range&) {
-      return std::numeric_limits<double>::infinity();
-    } catch (const std::invalid_argument&) {
-    }
-    fail("node id " + std::to_string(tag) + " has a malformed coordinate '" + s + "'");
+    char* end = nullptr;
+    const double v = std::strtod(s.c_str(), &end);
+    if (end != s.c_str() + s.size())
+      fail("node id " + std::to_string(tag) + " has a malformed coordinate '" + s + "'");
+    return v;
   }
 
   Vec3 point(std::size_t tag) {
@@ -129,25 +137,25 @@ class Parser {
   }
 
   void read_nodes_v2() {
-    const auto n = next<std::size_t>("$Nodes count");
+    const auto n = whole("$Nodes count");
     for (std::size_t i = 0; i < n; ++i) {
-      const auto tag = next<std::size_t>("$Nodes");
+      const auto tag = whole("$Nodes");
       add_node(tag, point(tag));
     }
   }
 
   void read_nodes_v4() {
-    const auto blocks = next<std::size_t>("$Nodes header");
-    next<std::size_t>("$Nodes header");
-    next<std::size_t>("$Nodes header");
-    next<std::size_t>("$Nodes header");
+    const auto blocks = whole("$Nodes header");
+    whole("$Nodes header");
+    whole("$Nodes header");
+    whole("$Nodes header");
     for (std::size_t b = 0; b < blocks; ++b) {
       const int dim = next<int>("$Nodes block header");
       next<int>("$Nodes block header");
       const int parametric = next<int>("$Nodes block header");  // then each node has `dim` parametric coordinates
-      const auto n = next<std::size_t>("$Nodes block header");
-      std::vector<std::size_t> tags(n);
-      for (auto& t : tags) t = next<std::size_t>("$Nodes block tags");
+      const auto n = whole("$Nodes block header");
+      std::vector<std::size_t> tags;  // not sized by the count read: a damaged count must not allocate
+      for (std::size_t i = 0; i < n; ++i) tags.push_back(whole("$Nodes block tags"));
       for (auto t : tags) {
         add_node(t, point(t));
         for (int k = 0; k < (parametric ? dim : 0); ++k) next<double>("$Nodes parametric coordinates");
@@ -160,34 +168,34 @@ class Parser {
   }
 
   void read_elements_v2() {
-    const auto n = next<std::size_t>("$Elements count");
+    const auto n = whole("$Elements count");
     for (std::size_t i = 0; i < n; ++i) {
-      const auto tag = next<std::size_t>("$Elements");
+      const auto tag = whole("$Elements");
       const int type = next<int>("$Elements");
       const int nn = nodes_per_element(type);
       if (nn < 0) fail("element id " + std::to_string(tag) + " has unknown Gmsh type " + std::to_string(type));
       const int ntags = next<int>("$Elements");
       for (int k = 0; k < ntags; ++k) next<long>("$Elements tags");
       std::vector<std::size_t> nodes(nn);
-      for (auto& v : nodes) v = next<std::size_t>("$Elements node ids");
+      for (auto& v : nodes) v = whole("$Elements node ids");
       add_element(tag, type, nodes);
     }
   }
 
   void read_elements_v4() {
-    const auto blocks = next<std::size_t>("$Elements header");
-    for (int k = 0; k < 3; ++k) next<std::size_t>("$Elements header");
+    const auto blocks = whole("$Elements header");
+    for (int k = 0; k < 3; ++k) whole("$Elements header");
     for (std::size_t b = 0; b < blocks; ++b) {
       next<int>("$Elements block header");
       next<int>("$Elements block header");
       const int type = next<int>("$Elements block header");
-      const auto n = next<std::size_t>("$Elements block header");
+      const auto n = whole("$Elements block header");
       const int nn = nodes_per_element(type);
       if (nn < 0) fail("element block " + std::to_string(b) + " has unknown Gmsh type " + std::to_string(type));
       std::vector<std::size_t> nodes(nn);
       for (std::size_t i = 0; i < n; ++i) {
-        const auto tag = next<std::size_t>("$Elements");
-        for (auto& v : nodes) v = next<std::size_t>("$Elements node ids");
+        const auto tag = whole("$Elements");
+        for (auto& v : nodes) v = whole("$Elements node ids");
         add_element(tag, type, nodes);
       }
     }
@@ -263,7 +271,8 @@ Mesh read_gmsh(std::istream& in, const std::string& label) { return Parser(in, l
 
 Mesh read_gmsh(const std::string& path) {
   std::ifstream in(path);
-  if (!in) throw InputError("mesh " + path + ": cannot open the file");
+  if (!in) throw InputError("mesh " + path + ": cannot open the file: " + std::strerror(errno));
+  if (std::filesystem::is_directory(path)) throw InputError("mesh " + path + ": cannot open the file: it is a directory");
   return read_gmsh(in, path);
 }
 

@@ -144,8 +144,17 @@ void keep_rows(const std::filesystem::path& path, const std::function<bool(long,
   std::ifstream in(path);
   if (!in) return;
   std::string line, kept;
-  for (long r = -1; std::getline(in, line); ++r)
-    if (r < 0 || keep(r, std::stod(line))) kept += line + "\n";
+  for (long r = -1; std::getline(in, line); ++r) {
+    if (r >= 0) {
+      char* end = nullptr;
+      const double first = std::strtod(line.c_str(), &end);
+      if (end == line.c_str() || (*end != ',' && *end != '\0'))
+        throw InputError("cannot continue " + path.string() + ": line " + std::to_string(r + 2) +
+                         " is not a row of numbers (damaged file)");
+      if (!keep(r, first)) continue;
+    }
+    kept += line + "\n";
+  }
   io::AtomicFile::write(path, kept);
 }
 
@@ -184,6 +193,26 @@ class Progress {
   clock::time_point t0_, last_;
 };
 
+std::string grid_text(const io::Config& c) {
+  return "grid " + std::to_string(c.get<int>("grid.nx")) + " x " + std::to_string(c.get<int>("grid.ny")) + " x " +
+         std::to_string(c.get<int>("grid.nz"));
+}
+
+// A grid far beyond the machine's memory is refused before anything is allocated (the operating system would
+// otherwise grant the memory and kill the run when it is touched). kBytesPerCell is a lower bound: the peak
+// resident memory of a run grows by about 300 bytes per cell (16^3 -> 64^3, frames and checkpoints written).
+void check_memory(const io::Config& c) {
+  constexpr double kBytesPerCell = 250;
+  const double cells = double(c.get<int>("grid.nx")) * c.get<int>("grid.ny") * c.get<int>("grid.nz");
+  const double memory = double(sysconf(_SC_PHYS_PAGES)) * double(sysconf(_SC_PAGESIZE));
+  if (memory > 0 && cells * kBytesPerCell > memory) {
+    std::ostringstream s;
+    s << std::setprecision(3) << grid_text(c) << " = " << cells << " cells: needs at least "
+      << cells * kBytesPerCell / 1e9 << " GB, this machine has " << memory / 1e9 << " GB";
+    throw InputError(s.str());
+  }
+}
+
 }  // namespace
 
 void print_config_help(std::ostream& out) { run_schema().print_help(out); }
@@ -209,7 +238,14 @@ int run_command(const RunOptions& options, std::ostream& out, std::ostream& err)
   const io::ConfigSchema schema = run_schema();
   const io::Config config = apply_scenario(schema.parse_file(options.file, options.sets));
   const bool restarted = !options.restart.empty();
-  Simulation sim(config);
+  check_memory(config);
+  std::unique_ptr<Simulation> built;
+  try {
+    built = std::make_unique<Simulation>(config);
+  } catch (const std::bad_alloc&) {
+    throw InputError(grid_text(config) + ": the fluid and membrane arrays do not fit in this machine's memory");
+  }
+  Simulation& sim = *built;
   std::unique_ptr<StretchSweep> sweep;
   if (is_sweep(config)) sweep = std::make_unique<StretchSweep>(sim);
   if (restarted) {
@@ -219,8 +255,15 @@ int run_command(const RunOptions& options, std::ostream& out, std::ostream& err)
   } else if (sweep) {
     sweep->start(sim, 0);
   }
-  std::filesystem::create_directories(options.out);
+  std::error_code ec;
+  std::filesystem::create_directories(options.out, ec);
+  if (ec) throw WriteError("cannot write " + options.out.string() + ": " + ec.message());
   const std::filesystem::path dir = options.out;
+  // A restart continues the tables after the checkpoint (a damaged table is refused before anything is rewritten).
+  if (restarted) {
+    keep_rows(dir / "diagnostics.csv", [&](long, double step) { return step <= double(sim.step()); });
+    if (sweep) keep_rows(dir / "stretch.csv", [&](long row, double) { return row < long(sweep->current()); });
+  }
 
   out << "# immerse " << IMMERSE_VERSION << ": " << options.file.string() << " -> " << dir.string() << "\n"
       << "# resolved configuration (saved as config.resolved.toml)\n"
@@ -228,11 +271,9 @@ int run_command(const RunOptions& options, std::ostream& out, std::ostream& err)
   config.save(dir / "config.resolved.toml");
 
   const auto mode = restarted ? io::CsvWriter::Mode::Append : io::CsvWriter::Mode::Create;
-  if (restarted) keep_rows(dir / "diagnostics.csv", [&](long, double step) { return step <= double(sim.step()); });
   io::CsvWriter csv(dir / "diagnostics.csv", diagnostics_columns(config, sim.num_membranes()), mode);
   std::optional<io::CsvWriter> stretch;
   if (sweep) {
-    if (restarted) keep_rows(dir / "stretch.csv", [&](long row, double) { return row < long(sweep->current()); });
     stretch.emplace(dir / "stretch.csv", std::vector<std::string>{"force_pN", "axial_um", "transverse_um"}, mode);
     out << "rbc_stretch: " << sweep->patch_nodes() << " nodes in the two contact patches, relaxation time "
         << sweep->relaxation_time() << " s\n";
@@ -242,6 +283,7 @@ int run_command(const RunOptions& options, std::ostream& out, std::ostream& err)
   if (restarted && fields_every > 0) first_frame = static_cast<int>(sim.step() / fields_every) + 1;
   io::XdmfWriter frames(dir, first_frame);
   StepRecord last;
+  long checkpoint_step = -1;  // of the last checkpoint this run wrote
 
   std::vector<Callback> callbacks{
       // A row needs the record of its step: the step that turned out unstable has none.
@@ -256,12 +298,11 @@ int run_command(const RunOptions& options, std::ostream& out, std::ostream& err)
          io::Checkpoint ck = s.checkpoint();
          if (sweep) sweep->save(ck);
          ck.write(dir / "checkpoint.h5");
+         checkpoint_step = s.step();
        }},
   };
-  for (auto& c : callbacks) {
+  for (auto& c : callbacks)
     if (restarted) c.last_step = sim.step();  // the restart step's row, frame and checkpoint already exist
-    if (c.at_start) c.run(sim, sim.step());
-  }
 
   g_stop_signal = 0;
   std::signal(SIGINT, on_signal);
@@ -294,6 +335,8 @@ int run_command(const RunOptions& options, std::ostream& out, std::ostream& err)
     if (g_stop_signal) status = 4;
   };
   try {
+    for (auto& c : callbacks)
+      if (c.at_start) c.run(sim, sim.step());
     while (status == 0 && !sim.finished() && !(sweep && sweep->done())) step_once();
     if (status == 0 && sweep && !sweep->done())
       out << "\nrbc_stretch: time.end reached during force " << sweep->current() + 1 << " of " << sweep->forces().size()
@@ -303,11 +346,21 @@ int run_command(const RunOptions& options, std::ostream& out, std::ostream& err)
     progress.finish();
     err << "immerse: run stopped: " << e.what() << "\n";
     status = 3;
+  } catch (const WriteError& e) {
+    // A full disk or a folder gone: no further write is attempted; what was written before is complete.
+    progress.finish();
+    err << "immerse: run stopped at step " << sim.step() << ", t = " << sim.time() << ": " << e.what() << " ("
+        << (checkpoint_step >= 0 ? "last checkpoint written: step " + std::to_string(checkpoint_step)
+                                 : std::string("no checkpoint written"))
+        << ")\n";
+    status = 5;
   }
   progress.finish();
-  // The last state is always saved, whatever ended the run (after an instability: the unstable state, for inspection).
-  for (auto& c : callbacks)
-    if (c.at_end && c.last_step != sim.step()) c.run(sim, sim.step());
+  // The last state is always saved, whatever ended the run (after an instability: the unstable state, for
+  // inspection), unless writing is what failed.
+  if (status != 5)
+    for (auto& c : callbacks)
+      if (c.at_end && c.last_step != sim.step()) c.run(sim, sim.step());
   if (status == 4) err << "immerse: interrupted by signal " << g_stop_signal << " at step " << sim.step() << ", t = "
                        << sim.time() << "; checkpoint written to " << (dir / "checkpoint.h5").string() << "\n";
   std::signal(SIGINT, SIG_DFL);

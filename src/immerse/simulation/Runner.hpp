@@ -17,7 +17,8 @@ struct RunOptions {
   std::filesystem::path restart;  ///< empty: start from t = 0
 };
 
-/// Exit status: 0 done, 2 bad input (nothing written), 3 the run became unstable, 4 interrupted by a signal.
+/// Exit status: 0 done, 2 bad input (nothing written), 3 the run became unstable, 4 interrupted by a signal,
+/// 5 an output file could not be written during the run (full disk; no further write, earlier files complete).
 int run_command(const RunOptions& options, std::ostream& out, std::ostream& err);
 
 /// Prints the bundled scenarios (scenarios/*.toml) with the first comment line of each.

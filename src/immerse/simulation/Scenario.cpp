@@ -41,7 +41,25 @@ std::vector<Vec3> channel_cell_centres(const io::Config& c) {
   return centres;
 }
 
-io::Config apply_scenario(const io::Config& config) {
+namespace {
+
+// Writes the derived values into their keys; one out of range (an extreme group overflowing or underflowing) is
+// reported as the scenario's, naming the keys it came from.
+io::Config with_derived(const io::Config& config, const std::vector<std::string>& set, const std::string& kind,
+                        const std::string& sources) {
+  io::Config derived = config;
+  try {
+    config.schema().apply_overrides(derived, set);
+  } catch (const InputError& e) {
+    std::string m = e.what();
+    if (m.rfind("--set: ", 0) == 0) m = m.substr(7);
+    throw InputError("scenario.kind = \"" + kind + "\" derives " + m + " (from " + sources + ")");
+  }
+  return derived;
+}
+
+// The dimensional values the scenario kind implies, written into their keys.
+io::Config derive(const io::Config& config) {
   const std::string kind = config.get<std::string>("scenario.kind");
   if (kind == "rbc_stretch" || kind == "rbc_channel") {
     if (config.count("membrane") != 1)
@@ -49,11 +67,11 @@ io::Config apply_scenario(const io::Config& config) {
                        (kind == "rbc_channel" ? "the template of every cell" : "the cell") + "), given " +
                        std::to_string(config.count("membrane")));
     const double mu0 = config.get<double>("scenario.mu0");
-    io::Config derived = config;
-    config.schema().apply_overrides(derived, std::vector<std::string>{"membrane[0].shape=\"rbc\"",
-                                                                      "membrane[0].law=\"yeoh\"",
-                                                                      "membrane[0].C10=" + num(mu0 / 2),
-                                                                      "membrane[0].C30=" + num(mu0 / 30)});
+    io::Config derived =
+        with_derived(config,
+                     {"membrane[0].shape=\"rbc\"", "membrane[0].law=\"yeoh\"", "membrane[0].C10=" + num(mu0 / 2),
+                      "membrane[0].C30=" + num(mu0 / 30)},
+                     kind, "scenario.mu0");
     if (kind == "rbc_stretch") return derived;
     for (const auto& [axis, bc] : {std::pair{"x", "wall"}, {"y", "periodic"}, {"z", "wall"}})
       require(config.get<std::string>(std::string("boundary.") + axis) == bc, std::string("boundary.") + axis,
@@ -96,8 +114,23 @@ io::Config apply_scenario(const io::Config& config) {
     set.push_back("membrane[0].aspect_ratio=" + num(config.get<double>("scenario.aspect_ratio")));
     set.push_back("membrane[0].inclination=" + num(config.get<double>("scenario.theta0")));
   }
-  io::Config derived = config;
-  config.schema().apply_overrides(derived, set);
+  return with_derived(config, set, kind,
+                      "scenario.G, scenario.Re, scenario.k_dt, scenario.kt_end, fluid.mu, fluid.rho, membrane[0].radius");
+}
+
+}  // namespace
+
+io::Config apply_scenario(const io::Config& config) {
+  const io::Config derived = derive(config);
+  // A step longer than the whole run is a mistake in one of the two (the run would silently take one short step).
+  const double dt = derived.get<double>("time.dt"), end = derived.get<double>("time.end");
+  if (dt > end) {
+    const bool shear = is_shear(config.get<std::string>("scenario.kind"));
+    const std::string step = shear ? "scenario.k_dt" : "time.dt", stop = shear ? "scenario.kt_end" : "time.end";
+    const double a = shear ? config.get<double>("scenario.k_dt") : dt;
+    const double b = shear ? config.get<double>("scenario.kt_end") : end;
+    throw InputError(step + " = " + num(a) + ": must be <= " + stop + " = " + num(b) + " (one step is longer than the run)");
+  }
   return derived;
 }
 

@@ -153,7 +153,10 @@ void Simulation::build_membranes() {
       references_.push_back(std::move(reference));
       initial_.push_back(std::move(initial));
     } catch (const InputError& e) {
-      throw InputError(name + "." + e.what());
+      // A key of the entry becomes membrane[i].key; the membrane's own "membrane reference element 3" becomes
+      // "membrane[i] reference element 3".
+      const std::string what = e.what();
+      throw InputError(what.rfind("membrane ", 0) == 0 ? name + what.substr(8) : name + "." + what);
     }
   }
 }
