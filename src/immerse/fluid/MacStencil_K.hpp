@@ -10,7 +10,13 @@
 //     ghost and first interior value equals the wall velocity u_w.
 // The pressure Laplacian uses the ghost p_g = p_0 (homogeneous Neumann, eq. 11): it is exactly D^MAC G^MAC
 // with G^MAC φ = 0 on the wall faces, so the projection (12) leaves D^MAC u^{n+1} = 0 to round-off.
+//
+// Two forms of each kernel: the generic one at an index (wraps indices, branches on the boundary type at every
+// access; valid everywhere), and an *_interior one on Views (no wrap, no branch), valid only where every value
+// it reads is a plain stored one (MacGeom::interior_begin/end). The interior forms do the
+// same floating-point operations in the same order, so both give bitwise the same result where both apply.
 #include <array>
+#include <cstddef>
 
 #include "immerse/core/Array3.hpp"
 #include "immerse/fluid/MacGeom.hpp"
@@ -66,6 +72,32 @@ inline FaceStencil gather(const Array3& ud, const MacGeom& g, int d, const Index
   return st;
 }
 
+/// An Array3 as the interior kernels read or write it: x has unit stride, so along a row of constant (j, k) the
+/// offsets of the neighbours are loop invariants and the kernels vectorize.
+template <class T>
+struct View {
+  T* p;
+  std::ptrdiff_t sy, sz;
+  template <class A>
+  explicit View(A& a) : p(a.data()), sy(a.nx()), sz(static_cast<std::ptrdiff_t>(a.nx()) * a.ny()) {}
+  /// Offset of a unit step along axis A.
+  template <int A>
+  std::ptrdiff_t stride() const {
+    if constexpr (A == 0) return 1;
+    else if constexpr (A == 1) return sy;
+    else return sz;
+  }
+  std::ptrdiff_t index(int i, int j, int k) const { return i + sy * j + sz * k; }
+  T& operator()(int i, int j, int k) const { return p[index(i, j, k)]; }
+};
+using ConstView = View<const double>;
+using MutView = View<double>;
+
+/// gather() at an interior face (i, j, k) of u_d.
+inline FaceStencil gather_interior(const ConstView& u, int i, int j, int k) {
+  return {u(i, j, k), {u(i - 1, j, k), u(i, j - 1, k), u(i, j, k - 1)}, {u(i + 1, j, k), u(i, j + 1, k), u(i, j, k + 1)}};
+}
+
 /// ∇_h² u_d from its stencil.
 inline double laplacian(const FaceStencil& st, const MacGeom& g) {
   double s = 0;
@@ -116,11 +148,43 @@ inline double advection_face(const FaceField& u, const MacGeom& g, int d, const 
   return 0.5 * g.inv_h * a;
 }
 
+/// Mean ū_E of the four E-faces around face (i, j, k) of component D ≠ E, in the order of advection_face().
+template <int D, int E>
+inline double mean_face_interior(const ConstView& ue, int i, int j, int k) {
+  const std::ptrdiff_t q = ue.index(i, j, k), pe = ue.stride<E>(), md = ue.stride<D>();
+  double sum = ue.p[q];
+  sum += ue.p[q + pe];
+  sum += ue.p[q + pe - md];
+  sum += ue.p[q - md];
+  return 0.25 * sum;
+}
+
+/// advection_face() at an interior face (i, j, k) of component D; st is the stencil of u_D there.
+template <int D>
+inline double advection_interior(const FaceStencil& st, const ConstView& u0, const ConstView& u1, const ConstView& u2,
+                                 int i, int j, int k, double inv_h) {
+  const double ub0 = D == 0 ? st.centre : mean_face_interior<D, 0>(u0, i, j, k);
+  const double ub1 = D == 1 ? st.centre : mean_face_interior<D, 1>(u1, i, j, k);
+  const double ub2 = D == 2 ? st.centre : mean_face_interior<D, 2>(u2, i, j, k);
+  double a = 0;
+  a += ub0 * (st.plus[0] - st.minus[0]);
+  a += ub1 * (st.plus[1] - st.minus[1]);
+  a += ub2 * (st.plus[2] - st.minus[2]);
+  return 0.5 * inv_h * a;
+}
+
 /// (G^MAC p)_d at face q (an unknown face: never a wall face).
 inline double gradient_face(const Array3& p, const MacGeom& g, int d, const Index& q) {
   Index r = q;
   r[d] = g.periodic[d] ? wrap(q[d] - 1, g.n[d]) : q[d] - 1;
   return (at(p, q) - at(p, r)) * g.inv_h;
+}
+
+/// gradient_face() at face (i, j, k) of component D where the cell behind it does not wrap.
+template <int D>
+inline double gradient_interior(const ConstView& p, int i, int j, int k, double inv_h) {
+  const std::ptrdiff_t q = p.index(i, j, k);
+  return (p.p[q] - p.p[q - p.stride<D>()]) * inv_h;
 }
 
 /// (D^MAC u) at cell q, from the face values stored in u (wall faces included).
@@ -132,6 +196,16 @@ inline double divergence_cell(const FaceField& u, const MacGeom& g, const Index&
     s += at(u[d], r) - at(u[d], q);
   }
   return s * g.inv_h;
+}
+
+/// divergence_cell() at cell (i, j, k) where no face beyond it wraps.
+inline double divergence_interior(const ConstView& u0, const ConstView& u1, const ConstView& u2, int i, int j, int k,
+                                  double inv_h) {
+  double s = 0;
+  s += u0(i + 1, j, k) - u0(i, j, k);
+  s += u1(i, j + 1, k) - u1(i, j, k);
+  s += u2(i, j, k + 1) - u2(i, j, k);
+  return s * inv_h;
 }
 
 /// D^MAC G^MAC φ at cell q: the 7-point Laplacian with ghost φ_g = φ_0 at walls (homogeneous Neumann).
