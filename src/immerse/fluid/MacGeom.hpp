@@ -38,11 +38,11 @@ struct MacGeom {
   /// First unknown index of velocity component d along axis a (the end is always n[a], exclusive).
   int first(int d, int a) const { return (a == d && !periodic[a]) ? 1 : 0; }
 
-  /// Interior faces of component d along axis a, [interior_begin, interior_end): the faces whose six neighbours,
-  /// the four faces of each other component around them (advection) and the cell behind them (gradient) are all
-  /// stored unknowns, with no periodic wrap, wall value, ghost value or wall source term (MacStencil_K.hpp).
-  int interior_begin(int d, int a) const { return (a == d && !periodic[a]) ? 2 : 1; }
-  int interior_end(int a) const { return n[a] - 1; }
+  /// Faces of component d along a wall axis a, [interior_begin, interior_end), whose six neighbours, the four
+  /// faces of each other component around them (advection) and the cell behind them (gradient) are all stored
+  /// unknowns: no wall value, ghost value or wall source term (MacStencil_K.hpp). On a periodic axis every face.
+  int interior_begin(int d, int a) const { return periodic[a] ? 0 : (a == d ? 2 : 1); }
+  int interior_end(int a) const { return periodic[a] ? n[a] : n[a] - 1; }
 };
 
 /// Calls f(i, j, k) for every unknown of velocity component d (OpenMP over the two outer axes).
@@ -62,7 +62,7 @@ struct IndexBox {
 
 /// Visits every index of `all`: rows (j, k) inside `fast` along y and z get row(j, k, fast.begin[0],
 /// fast.end[0]) for their x-range inside `fast` and point(i, j, k) for the rest; every other row is visited by
-/// point() alone. OpenMP over the two outer axes, like for_each_face. `fast` must lie inside `all`.
+/// point() alone (the generic kernels). OpenMP over the two outer axes, like for_each_face. `fast` must lie inside `all`.
 template <class Point, class Row>
 void for_each_split(const MacGeom& g, const IndexBox& all, const IndexBox& fast, Point&& point, Row&& row) {
   const int i0 = all.begin[0], i1 = all.end[0];
@@ -83,7 +83,16 @@ void for_each_split(const MacGeom& g, const IndexBox& all, const IndexBox& fast,
     }
 }
 
-/// The unknowns of velocity component d, and among them the interior faces (MacGeom::interior_begin/end).
+/// Calls row(j, k, box.begin[0], box.end[0]) for every row of the box (OpenMP over the two outer axes).
+template <class Row>
+void for_each_row(const MacGeom& g, const IndexBox& box, Row&& row) {
+#pragma omp parallel for collapse(2) schedule(static) if (g.threaded())
+  for (int k = box.begin[2]; k < box.end[2]; ++k)
+    for (int j = box.begin[1]; j < box.end[1]; ++j) row(j, k, box.begin[0], box.end[0]);
+}
+
+/// The unknowns of velocity component d, and among them those where the row kernels apply
+/// (MacGeom::interior_begin/end).
 inline IndexBox face_box(const MacGeom& g, int d) {
   return {{g.first(d, 0), g.first(d, 1), g.first(d, 2)}, g.n};
 }

@@ -12,9 +12,10 @@
 // with G^MAC φ = 0 on the wall faces, so the projection (12) leaves D^MAC u^{n+1} = 0 to round-off.
 //
 // Two forms of each kernel: the generic one at an index (wraps indices, branches on the boundary type at every
-// access; valid everywhere), and an *_interior one on Views (no wrap, no branch), valid only where every value
-// it reads is a plain stored one (MacGeom::interior_begin/end). The interior forms do the
-// same floating-point operations in the same order, so both give bitwise the same result where both apply.
+// access; valid everywhere), and a *_row one that reads through an accessor of the neighbouring rows (Strided,
+// or WrappedRows on periodic boundary rows; no branch), valid wherever every value it reads is a stored one, i.e. away from
+// the wall layers (MacGeom::interior_begin/end). Both forms do the same floating-point operations in the same
+// order, so they give bitwise the same result where both apply.
 #include <array>
 #include <cstddef>
 
@@ -72,38 +73,82 @@ inline FaceStencil gather(const Array3& ud, const MacGeom& g, int d, const Index
   return st;
 }
 
-/// An Array3 as the interior kernels read or write it: x has unit stride, so along a row of constant (j, k) the
-/// offsets of the neighbours are loop invariants and the kernels vectorize.
-template <class T>
-struct View {
-  T* p;
-  std::ptrdiff_t sy, sz;
-  template <class A>
-  explicit View(A& a) : p(a.data()), sy(a.nx()), sz(static_cast<std::ptrdiff_t>(a.nx()) * a.ny()) {}
-  /// Offset of a unit step along axis A.
-  template <int A>
-  std::ptrdiff_t stride() const {
-    if constexpr (A == 0) return 1;
-    else if constexpr (A == 1) return sy;
-    else return sz;
+/// Indices i − 1, i, i + 1 along x (wrapped on a periodic axis); X<DX>() picks one.
+struct XIndex {
+  int m, c, p;
+  template <int DX>
+  int at() const {
+    if constexpr (DX < 0) return m;
+    else if constexpr (DX > 0) return p;
+    else return c;
   }
-  std::ptrdiff_t index(int i, int j, int k) const { return i + sy * j + sz * k; }
-  T& operator()(int i, int j, int k) const { return p[index(i, j, k)]; }
 };
-using ConstView = View<const double>;
-using MutView = View<double>;
 
-/// gather() at an interior face (i, j, k) of u_d.
-inline FaceStencil gather_interior(const ConstView& u, int i, int j, int k) {
-  return {u(i, j, k), {u(i - 1, j, k), u(i, j - 1, k), u(i, j, k - 1)}, {u(i + 1, j, k), u(i, j + 1, k), u(i, j, k + 1)}};
+/// 1 if A == axis: the components of the unit vector e_A.
+constexpr int unit(int A, int axis) { return A == axis ? 1 : 0; }
+
+/// How the row kernels read an Array3 around row (j, k): at<DX, DY, DZ>(x) is the element (x + DX, j + DY, k + DZ).
+/// Two accessors: Strided for rows whose neighbour rows do not wrap (offsets ±1 row, ±1 plane: the common case,
+/// few registers), WrappedRows for the boundary rows of a periodic y or z axis (the nine neighbour rows located
+/// once, wrapped). Along a row the kernels index by XIndex: loop-invariant rows, unit stride, so they vectorize.
+struct Strided {
+  const double* row;
+  std::ptrdiff_t sy, sz;
+  Strided(const Array3& a, const MacGeom&, int j, int k)
+      : row(a.data() + a.index(0, j, k)), sy(a.nx()), sz(static_cast<std::ptrdiff_t>(a.nx()) * a.ny()) {}
+  template <int DX, int DY, int DZ>
+  double at(XIndex x) const {
+    return row[x.at<DX>() + DY * sy + DZ * sz];
+  }
+};
+
+/// Whether row (j, k) has neighbour rows that wrap (it lies on the boundary of a periodic y or z axis): then the
+/// kernels must read through WrappedRows.
+inline bool row_wraps(const MacGeom& g, int j, int k) {
+  return (g.periodic[1] && (j == 0 || j == g.n[1] - 1)) || (g.periodic[2] && (k == 0 || k == g.n[2] - 1));
+}
+
+/// row[dy + 1][dz + 1] points at element (0, j + dy, k + dz), indices wrapped on periodic axes (null if beyond
+/// the array on a wall axis: such a row is never read where the row kernels apply).
+struct WrappedRows {
+  const double* row[3][3];
+  WrappedRows(const Array3& a, const MacGeom& g, int j, int k) {
+    for (int dz = -1; dz <= 1; ++dz)
+      for (int dy = -1; dy <= 1; ++dy) {
+        int jj = j + dy, kk = k + dz;
+        if (g.periodic[1]) jj = wrap(jj, a.ny());
+        if (g.periodic[2]) kk = wrap(kk, a.nz());
+        row[dy + 1][dz + 1] = (jj >= 0 && jj < a.ny() && kk >= 0 && kk < a.nz()) ? a.data() + a.index(0, jj, kk)
+                                                                                 : nullptr;
+      }
+  }
+  template <int DX, int DY, int DZ>
+  double at(XIndex x) const {
+    return row[DY + 1][DZ + 1][x.at<DX>()];
+  }
+};
+
+/// Element (x + DX, j + DY, k + DZ) through the accessor r of row (j, k).
+template <int DX, int DY, int DZ, class R>
+inline double rd(const R& r, XIndex x) {
+  return r.template at<DX, DY, DZ>(x);
+}
+
+/// gather() at a face of u_d whose six neighbours are stored values (rows of u_d around the face's row).
+template <class R>
+inline FaceStencil gather_row(const R& u, XIndex x) {
+  return {rd<0, 0, 0>(u, x),
+          {rd<-1, 0, 0>(u, x), rd<0, -1, 0>(u, x), rd<0, 0, -1>(u, x)},
+          {rd<1, 0, 0>(u, x), rd<0, 1, 0>(u, x), rd<0, 0, 1>(u, x)}};
 }
 
 /// ∇_h² u_d from its stencil.
-inline double laplacian(const FaceStencil& st, const MacGeom& g) {
+inline double laplacian(const FaceStencil& st, double inv_h2) {
   double s = 0;
   for (int e = 0; e < 3; ++e) s += st.minus[e] - 2.0 * st.centre + st.plus[e];
-  return s * g.inv_h2;
+  return s * inv_h2;
 }
+inline double laplacian(const FaceStencil& st, const MacGeom& g) { return laplacian(st, g.inv_h2); }
 
 /// ∇_h² u_d at face q of component d, with the boundary values of g.
 inline double laplacian_face(const Array3& ud, const MacGeom& g, int d, const Index& q) {
@@ -148,24 +193,23 @@ inline double advection_face(const FaceField& u, const MacGeom& g, int d, const 
   return 0.5 * g.inv_h * a;
 }
 
-/// Mean ū_E of the four E-faces around face (i, j, k) of component D ≠ E, in the order of advection_face().
-template <int D, int E>
-inline double mean_face_interior(const ConstView& ue, int i, int j, int k) {
-  const std::ptrdiff_t q = ue.index(i, j, k), pe = ue.stride<E>(), md = ue.stride<D>();
-  double sum = ue.p[q];
-  sum += ue.p[q + pe];
-  sum += ue.p[q + pe - md];
-  sum += ue.p[q - md];
+/// Mean ū_E of the four E-faces around a face of component D ≠ E, in the order of advection_face().
+template <int D, int E, class R>
+inline double mean_face_row(const R& ue, XIndex x) {
+  double sum = rd<0, 0, 0>(ue, x);
+  sum += rd<unit(E, 0), unit(E, 1), unit(E, 2)>(ue, x);
+  sum += rd<unit(E, 0) - unit(D, 0), unit(E, 1) - unit(D, 1), unit(E, 2) - unit(D, 2)>(ue, x);
+  sum += rd<-unit(D, 0), -unit(D, 1), -unit(D, 2)>(ue, x);
   return 0.25 * sum;
 }
 
-/// advection_face() at an interior face (i, j, k) of component D; st is the stencil of u_D there.
-template <int D>
-inline double advection_interior(const FaceStencil& st, const ConstView& u0, const ConstView& u1, const ConstView& u2,
-                                 int i, int j, int k, double inv_h) {
-  const double ub0 = D == 0 ? st.centre : mean_face_interior<D, 0>(u0, i, j, k);
-  const double ub1 = D == 1 ? st.centre : mean_face_interior<D, 1>(u1, i, j, k);
-  const double ub2 = D == 2 ? st.centre : mean_face_interior<D, 2>(u2, i, j, k);
+/// advection_face() at a face of component D whose reads are all stored values; st is the stencil of u_D there.
+template <int D, class R>
+inline double advection_row(const FaceStencil& st, const R& u0, const R& u1, const R& u2, XIndex x,
+                            double inv_h) {
+  const double ub0 = D == 0 ? st.centre : mean_face_row<D, 0>(u0, x);
+  const double ub1 = D == 1 ? st.centre : mean_face_row<D, 1>(u1, x);
+  const double ub2 = D == 2 ? st.centre : mean_face_row<D, 2>(u2, x);
   double a = 0;
   a += ub0 * (st.plus[0] - st.minus[0]);
   a += ub1 * (st.plus[1] - st.minus[1]);
@@ -180,11 +224,10 @@ inline double gradient_face(const Array3& p, const MacGeom& g, int d, const Inde
   return (at(p, q) - at(p, r)) * g.inv_h;
 }
 
-/// gradient_face() at face (i, j, k) of component D where the cell behind it does not wrap.
-template <int D>
-inline double gradient_interior(const ConstView& p, int i, int j, int k, double inv_h) {
-  const std::ptrdiff_t q = p.index(i, j, k);
-  return (p.p[q] - p.p[q - p.stride<D>()]) * inv_h;
+/// gradient_face() at an unknown face of component D, from the rows of p.
+template <int D, class R>
+inline double gradient_row(const R& p, XIndex x, double inv_h) {
+  return (rd<0, 0, 0>(p, x) - rd<-unit(D, 0), -unit(D, 1), -unit(D, 2)>(p, x)) * inv_h;
 }
 
 /// (D^MAC u) at cell q, from the face values stored in u (wall faces included).
@@ -198,13 +241,13 @@ inline double divergence_cell(const FaceField& u, const MacGeom& g, const Index&
   return s * g.inv_h;
 }
 
-/// divergence_cell() at cell (i, j, k) where no face beyond it wraps.
-inline double divergence_interior(const ConstView& u0, const ConstView& u1, const ConstView& u2, int i, int j, int k,
-                                  double inv_h) {
+/// divergence_cell() from the rows of the three components around the cell's row.
+template <class R>
+inline double divergence_row(const R& u0, const R& u1, const R& u2, XIndex x, double inv_h) {
   double s = 0;
-  s += u0(i + 1, j, k) - u0(i, j, k);
-  s += u1(i, j + 1, k) - u1(i, j, k);
-  s += u2(i, j, k + 1) - u2(i, j, k);
+  s += rd<1, 0, 0>(u0, x) - rd<0, 0, 0>(u0, x);
+  s += rd<0, 1, 0>(u1, x) - rd<0, 0, 0>(u1, x);
+  s += rd<0, 0, 1>(u2, x) - rd<0, 0, 0>(u2, x);
   return s * inv_h;
 }
 
@@ -223,6 +266,24 @@ inline double laplacian_cell_neumann(const Array3& phi, const MacGeom& g, const 
       s += at(phi, r) - c;
     }
   return s * g.inv_h2;
+}
+
+/// Calls kernel(XIndex{i − 1, i, i + 1}) for i in [i0, i1), the neighbours wrapped modulo n on a periodic x
+/// axis: the two ends one by one, the rest in a loop the compiler vectorizes (OpenMP simd).
+template <class Kernel>
+void along_row(int i0, int i1, int n, bool periodic, Kernel&& kernel) {
+  if (periodic && i0 < i1) {
+    if (i0 == 0) {
+      kernel(XIndex{n - 1, 0, n > 1 ? 1 : 0});
+      i0 = 1;
+    }
+    if (i1 == n && i1 > i0) {
+      kernel(XIndex{n - 2, n - 1, 0});
+      i1 = n - 1;
+    }
+  }
+#pragma omp simd
+  for (int i = i0; i < i1; ++i) kernel(XIndex{i - 1, i, i + 1});
 }
 
 }  // namespace immerse::mac

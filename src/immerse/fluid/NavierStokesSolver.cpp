@@ -39,8 +39,32 @@ inline double rhs_face(const RhsCoefficients& c, bool first, double un, double a
   return un + c.dt_rho * (-c.rho * a - grad_p + c.half_mu * lap + f + c.fb);
 }
 
-/// Writes (u·∇_h u)^n into adv and the right-hand side of (9) into rhs at every unknown of component D: interior
-/// faces by the pointer kernels along unit-stride rows, the boundary layers by the generic kernels.
+/// (u·∇_h u)^n (into adv) and the right-hand side of (9) (into rhs) along row (j, k) of component D, i in
+/// [i0, i1) (no wall layer), reading through accessor R.
+template <int D, bool First, class R>
+void rhs_row(const MacGeom& g, const FluidState& in, const FaceField& force, const RhsCoefficients& c, Array3& adv,
+             Array3& rhs, int j, int k, int i0, int i1) {
+  // Everything the loop reads in locals: the compiler then sees loop-invariant rows and vectorizes.
+  const R ru(in.u[D], g, j, k), r0(in.u[0], g, j, k), r1(in.u[1], g, j, k), r2(in.u[2], g, j, k), rp(in.p, g, j, k);
+  const std::size_t o = adv.index(0, j, k);
+  const double* const fr = force[D].data() + o;
+  const double* const old = First ? nullptr : in.adv[D].data() + o;  // (not read on the first step)
+  double* const ar = adv.data() + o;
+  double* const rr = rhs.data() + o;
+  const RhsCoefficients cc = c;
+  const double inv_h = g.inv_h, inv_h2 = g.inv_h2;
+  mac::along_row(i0, i1, g.n[0], g.periodic[0], [&](mac::XIndex x) __attribute__((always_inline)) {
+    const int i = x.c;
+    const mac::FaceStencil st = mac::gather_row(ru, x);
+    const double a_now = mac::advection_row<D>(st, r0, r1, r2, x, inv_h);
+    ar[i] = a_now;
+    rr[i] = rhs_face(cc, First, st.centre, a_now, First ? 0.0 : old[i], mac::laplacian(st, inv_h2),
+                     mac::gradient_row<D>(rp, x, inv_h), fr[i]);
+  });
+}
+
+/// Writes (u·∇_h u)^n into adv and the right-hand side of (9) into rhs at every unknown of component D: the row
+/// kernels wherever they apply, the generic kernels in the wall layers.
 template <int D, bool First>
 void build_rhs_t(const MacGeom& g, const FluidState& in, const FaceField& force, const RhsCoefficients& c,
                  Array3& adv, Array3& rhs) {
@@ -57,30 +81,11 @@ void build_rhs_t(const MacGeom& g, const FluidState& in, const FaceField& force,
                                 mac::gradient_face(p, g, D, q), f(i, j, k));
       },
       [&](int j, int k, int i0, int i1) {
-        // Everything the loop reads in locals: the compiler then sees loop-invariant strides and vectorizes.
-        const mac::ConstView vu(un), u0(in.u[0]), u1(in.u[1]), u2(in.u[2]), vp(p), vf(f);
-        const mac::ConstView vold = First ? vu : mac::ConstView(in.adv[D]);  // (not read on the first step)
-        const mac::MutView va(adv), vr(rhs);
-        const RhsCoefficients cc = c;
-        const MacGeom& gg = g;
-        const double inv_h = gg.inv_h;
-#pragma omp simd
-        for (int i = i0; i < i1; ++i) {
-          const mac::FaceStencil st = mac::gather_interior(vu, i, j, k);
-          const double a_now = mac::advection_interior<D>(st, u0, u1, u2, i, j, k, inv_h);
-          va(i, j, k) = a_now;
-          vr(i, j, k) = rhs_face(cc, First, vu(i, j, k), a_now, First ? 0.0 : vold(i, j, k), mac::laplacian(st, gg),
-                                 mac::gradient_interior<D>(vp, i, j, k, inv_h), vf(i, j, k));
-        }
+        if (mac::row_wraps(g, j, k))
+          rhs_row<D, First, mac::WrappedRows>(g, in, force, c, adv, rhs, j, k, i0, i1);
+        else
+          rhs_row<D, First, mac::Strided>(g, in, force, c, adv, rhs, j, k, i0, i1);
       });
-}
-
-/// (12) along one row of interior faces of component D: u^{n+1} = u* − (Δt/ρ) G φ.
-template <int D>
-void project_row(const mac::ConstView& us, const mac::ConstView& phi, const mac::MutView& un1, int j, int k, int i0,
-                 int i1, double dt_rho, double inv_h) {
-#pragma omp simd
-  for (int i = i0; i < i1; ++i) un1(i, j, k) = us(i, j, k) - dt_rho * mac::gradient_interior<D>(phi, i, j, k, inv_h);
 }
 
 template <int D>
@@ -90,6 +95,45 @@ void build_rhs(const MacGeom& g, const FluidState& in, const FaceField& force, c
     build_rhs_t<D, true>(g, in, force, c, adv, rhs);
   else
     build_rhs_t<D, false>(g, in, force, c, adv, rhs);
+}
+
+/// D u* (into div) and the right-hand side (ρ/Δt) D u* of (11) (into phi) along row (j, k) of the cells.
+template <class R>
+void divergence_row(const MacGeom& g, const FaceField& us, double rho_dt, Array3& div, Array3& phi, int j, int k,
+                    int i0, int i1) {
+  const R r0(us[0], g, j, k), r1(us[1], g, j, k), r2(us[2], g, j, k);
+  double* const dr = div.data() + div.index(0, j, k);
+  double* const pr = phi.data() + phi.index(0, j, k);
+  const double inv_h = g.inv_h;
+  mac::along_row(i0, i1, g.n[0], g.periodic[0], [&](mac::XIndex x) __attribute__((always_inline)) {
+    const double dv = mac::divergence_row(r0, r1, r2, x, inv_h);
+    dr[x.c] = dv;
+    pr[x.c] = rho_dt * dv;
+  });
+}
+
+/// (12) along row (j, k) of the unknowns of component D: u^{n+1} = u* − (Δt/ρ) G φ.
+template <int D, class R>
+void project_row(const MacGeom& g, const Array3& us, const Array3& phi, Array3& un1, int j, int k, int i0, int i1,
+                 double dt_rho) {
+  const R rphi(phi, g, j, k);
+  const std::size_t o = us.index(0, j, k);
+  const double* const sr = us.data() + o;
+  double* const nr = un1.data() + o;
+  const double inv_h = g.inv_h;
+  mac::along_row(i0, i1, g.n[0], g.periodic[0], [&](mac::XIndex x) __attribute__((always_inline)) {
+    nr[x.c] = sr[x.c] - dt_rho * mac::gradient_row<D>(rphi, x, inv_h);
+  });
+}
+
+template <int D>
+void project(const MacGeom& g, const Array3& us, const Array3& phi, Array3& un1, double dt_rho) {
+  for_each_row(g, face_box(g, D), [&](int j, int k, int i0, int i1) {
+    if (mac::row_wraps(g, j, k))
+      project_row<D, mac::WrappedRows>(g, us, phi, un1, j, k, i0, i1, dt_rho);
+    else
+      project_row<D, mac::Strided>(g, us, phi, un1, j, k, i0, i1, dt_rho);
+  });
 }
 
 }  // namespace
@@ -167,53 +211,19 @@ void NavierStokesSolver::step(const FluidState& in, const FaceField& force, doub
 
   // (11): ∇_h² φ = (ρ/Δt) D u*, Neumann walls.
   const double rho_dt = rho / dt;
-  {
-    IndexBox all{{0, 0, 0}, g.n}, fast = all;
-    for (int a = 0; a < 3; ++a)
-      if (g.periodic[a]) fast.end[a] = std::max(0, g.n[a] - 1);  // q + e_a wraps at the last cell
-    for_each_split(
-        g, all, fast,
-        [&](int i, int j, int k) {
-          const double dv = mac::divergence_cell(ustar_, g, {i, j, k});
-          div_(i, j, k) = dv;
-          phi_(i, j, k) = rho_dt * dv;
-        },
-        [&](int j, int k, int i0, int i1) {
-          const mac::ConstView u0(ustar_[0]), u1(ustar_[1]), u2(ustar_[2]);
-          const mac::MutView vd(div_), vphi(phi_);
-          const double inv_h = g.inv_h, s = rho_dt;
-#pragma omp simd
-          for (int i = i0; i < i1; ++i) {
-            const double dv = mac::divergence_interior(u0, u1, u2, i, j, k, inv_h);
-            vd(i, j, k) = dv;
-            vphi(i, j, k) = s * dv;
-          }
-        });
-  }
+  for_each_row(g, IndexBox{{0, 0, 0}, g.n}, [&](int j, int k, int i0, int i1) {
+    if (mac::row_wraps(g, j, k))
+      divergence_row<mac::WrappedRows>(g, ustar_, rho_dt, div_, phi_, j, k, i0, i1);
+    else
+      divergence_row<mac::Strided>(g, ustar_, rho_dt, div_, phi_, j, k, i0, i1);
+  });
   solvers_[3]->solve(phi_, 0.0, 1.0);
 
   // (12) and (13).
   const double dt_rho = coef.dt_rho;
-  for (int d = 0; d < 3; ++d) {
-    const Array3& us = ustar_[d];
-    Array3& un1 = out.u[d];
-    const IndexBox all = face_box(g, d);
-    IndexBox fast = all;
-    fast.begin[d] = std::min(std::max(fast.begin[d], 1), fast.end[d]);  // q − e_d wraps at face 0
-    for_each_split(
-        g, all, fast,
-        [&](int i, int j, int k) { un1(i, j, k) = us(i, j, k) - dt_rho * mac::gradient_face(phi_, g, d, {i, j, k}); },
-        [&](int j, int k, int i0, int i1) {
-          const mac::ConstView vs(us), vphi(phi_);
-          const mac::MutView vn(un1);
-          const double inv_h = g.inv_h, s = dt_rho;
-          switch (d) {
-            case 0: project_row<0>(vs, vphi, vn, j, k, i0, i1, s, inv_h); break;
-            case 1: project_row<1>(vs, vphi, vn, j, k, i0, i1, s, inv_h); break;
-            default: project_row<2>(vs, vphi, vn, j, k, i0, i1, s, inv_h); break;
-          }
-        });
-  }
+  project<0>(g, ustar_[0], phi_, out.u[0], dt_rho);
+  project<1>(g, ustar_[1], phi_, out.u[1], dt_rho);
+  project<2>(g, ustar_[2], phi_, out.u[2], dt_rho);
   apply_wall_values(out.u);
   {
     const double half_mu = coef.half_mu;
