@@ -231,7 +231,8 @@ TEST(MacOperators, RowKernelsEqualTheGenericOnesBitwise) {
       for (int j = 0; j < 6; ++j) {
         const mac::WrappedRows r0(u[0], geom, j, k), r1(u[1], geom, j, k), r2(u[2], geom, j, k);
         for (int i = 0; i < 7; ++i) {
-          const mac::XIndex x{geom.periodic[0] ? mac::wrap(i - 1, 7) : i - 1, i, geom.periodic[0] ? mac::wrap(i + 1, 7) : i + 1};
+          const auto wrap = [&](int m) { return geom.periodic[0] ? mac::wrap(m, 7) : m; };
+          const mac::XIndex x{wrap(i - 1), i, wrap(i + 1)};
           bad += mac::divergence_row(r0, r1, r2, x, geom.inv_h) != mac::divergence_cell(u, geom, {i, j, k});
         }
       }

@@ -62,7 +62,8 @@ struct IndexBox {
 
 /// Visits every index of `all`: rows (j, k) inside `fast` along y and z get row(j, k, fast.begin[0],
 /// fast.end[0]) for their x-range inside `fast` and point(i, j, k) for the rest; every other row is visited by
-/// point() alone (the generic kernels). OpenMP over the two outer axes, like for_each_face. `fast` must lie inside `all`.
+/// point() alone (the generic kernels). OpenMP over the two outer axes, like for_each_face. `fast` must lie
+/// inside `all`.
 template <class Point, class Row>
 void for_each_split(const MacGeom& g, const IndexBox& all, const IndexBox& fast, Point&& point, Row&& row) {
   const int i0 = all.begin[0], i1 = all.end[0];

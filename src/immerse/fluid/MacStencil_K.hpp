@@ -13,9 +13,9 @@
 //
 // Two forms of each kernel: the generic one at an index (wraps indices, branches on the boundary type at every
 // access; valid everywhere), and a *_row one that reads through an accessor of the neighbouring rows (Strided,
-// or WrappedRows on periodic boundary rows; no branch), valid wherever every value it reads is a stored one, i.e. away from
-// the wall layers (MacGeom::interior_begin/end). Both forms do the same floating-point operations in the same
-// order, so they give bitwise the same result where both apply.
+// or WrappedRows on periodic boundary rows; no branch), valid wherever every value it reads is a stored one,
+// i.e. away from the wall layers (MacGeom::interior_begin/end). Both forms do the same floating-point operations
+// in the same order, so they give bitwise the same result where both apply.
 #include <array>
 #include <cstddef>
 
@@ -269,7 +269,9 @@ inline double laplacian_cell_neumann(const Array3& phi, const MacGeom& g, const 
 }
 
 /// Calls kernel(XIndex{i − 1, i, i + 1}) for i in [i0, i1), the neighbours wrapped modulo n on a periodic x
-/// axis: the two ends one by one, the rest in a loop the compiler vectorizes (OpenMP simd).
+/// axis: the two ends one by one, the rest in a loop the compiler vectorizes (OpenMP simd). Callers mark the
+/// kernel lambda __attribute__((always_inline)): called from three places, GCC would not inline it otherwise, and
+/// a loop around a call does not vectorize.
 template <class Kernel>
 void along_row(int i0, int i1, int n, bool periodic, Kernel&& kernel) {
   if (periodic && i0 < i1) {
