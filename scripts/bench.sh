@@ -10,10 +10,14 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 filter=${1:-}
-cmake --preset release >/dev/null
-cmake --build --preset release -j 2 --target bench_fluid bench_coupling bench_membrane bench_oscillating >/dev/null
 out=build/release/bench/results
 mkdir -p "$out"
+rm -f "$out"/*.json "$out"/*.txt
+if ! { cmake --preset release && cmake --build --preset release -j 2 --target bench_fluid bench_coupling bench_membrane \
+         bench_oscillating; } >"$out/build.log" 2>&1; then
+  cat "$out/build.log" >&2
+  exit 1
+fi
 echo "machine: $(nproc) cores, load average $(cut -d' ' -f1-3 /proc/loadavg) at start" | tee "$out/machine.txt"
 for b in bench_fluid bench_coupling bench_membrane; do
   echo "running $b ..." >&2

@@ -9,7 +9,7 @@ import sys
 
 def load(directory, name):
     path = os.path.join(directory, name + ".json")
-    if not os.path.exists(path):
+    if not os.path.exists(path) or os.path.getsize(path) == 0:  # (empty: the filter matched no case)
         return []
     with open(path) as f:
         return [b for b in json.load(f)["benchmarks"] if b.get("run_type", "iteration") == "iteration"]
