@@ -167,6 +167,79 @@ TEST(MacOperators, DivergenceIsMinusTheAdjointOfTheGradient) {
   }
 }
 
+// The row kernels of the step's fast path (MacStencil_K.hpp) against the generic ones, on every face where they
+// apply, for every boundary combination and both accessors: the same operations in the same order, so bitwise.
+template <int D>
+int row_kernel_mismatches(const MacGeom& g, const FaceField& u, const Array3& p) {
+  int bad = 0;
+  const IndexBox box = interior_face_box(g, D);
+  for (int k = box.begin[2]; k < box.end[2]; ++k)
+    for (int j = box.begin[1]; j < box.end[1]; ++j) {
+      const mac::WrappedRows w0(u[0], g, j, k), w1(u[1], g, j, k), w2(u[2], g, j, k), wd(u[D], g, j, k),
+          wp(p, g, j, k);
+      for (int i = box.begin[0]; i < box.end[0]; ++i) {
+        const mac::Index q{i, j, k};
+        const auto wrap = [&](int m) { return g.periodic[0] ? mac::wrap(m, g.n[0]) : m; };
+        const mac::XIndex x{wrap(i - 1), i, wrap(i + 1)};
+        const mac::FaceStencil st = mac::gather(u[D], g, D, q);
+        const double adv = mac::advection_face(u, g, D, q, st), grad = mac::gradient_face(p, g, D, q);
+        const double lap = mac::laplacian(st, g);
+        bad += mac::wall_source_face(g, D, q) != 0.0;
+        const auto check = [&](const auto& r0, const auto& r1, const auto& r2, const auto& rd, const auto& rp) {
+          const mac::FaceStencil sr = mac::gather_row(rd, x);
+          bad += mac::advection_row<D>(sr, r0, r1, r2, x, g.inv_h) != adv;
+          bad += mac::gradient_row<D>(rp, x, g.inv_h) != grad;
+          bad += mac::laplacian(sr, g) != lap;
+        };
+        check(w0, w1, w2, wd, wp);
+        if (!mac::row_wraps(g, j, k))
+          check(mac::Strided(u[0], g, j, k), mac::Strided(u[1], g, j, k), mac::Strided(u[2], g, j, k),
+                mac::Strided(u[D], g, j, k), mac::Strided(p, g, j, k));
+      }
+    }
+  return bad;
+}
+
+TEST(MacOperators, RowKernelsEqualTheGenericOnesBitwise) {
+  for (int combo = 0; combo < 8; ++combo) {
+    std::array<Boundary, 3> bc{};
+    for (int a = 0; a < 3; ++a) bc[a] = (combo >> a) & 1 ? W : P;
+    const Grid g({7, 6, 5}, {0.7, 0.6, 0.5}, bc);
+    FluidParams prm;
+    for (int a = 0; a < 3; ++a) {
+      prm.wall_lower[a] = {0.3, -0.2, 0.1};
+      prm.wall_upper[a] = {-0.4, 0.5, 0.7};
+      prm.wall_lower[a][a] = prm.wall_upper[a][a] = 0.25;
+    }
+    const MacGeom geom(g, prm);
+    std::mt19937 rng(static_cast<unsigned>(combo));
+    FaceField u(g);
+    for (int d = 0; d < 3; ++d) randomize(u[d], rng);
+    Array3 p(7, 6, 5);
+    randomize(p, rng);
+    long faces = 0;
+    for (int d = 0; d < 3; ++d) {
+      const IndexBox b = interior_face_box(geom, d);
+      faces += static_cast<long>(b.end[0] - b.begin[0]) * (b.end[1] - b.begin[1]) * (b.end[2] - b.begin[2]);
+    }
+    EXPECT_GT(faces, 0) << "combination " << combo;
+    EXPECT_EQ(row_kernel_mismatches<0>(geom, u, p), 0) << "combination " << combo;
+    EXPECT_EQ(row_kernel_mismatches<1>(geom, u, p), 0) << "combination " << combo;
+    EXPECT_EQ(row_kernel_mismatches<2>(geom, u, p), 0) << "combination " << combo;
+    int bad = 0;
+    for (int k = 0; k < 5; ++k)
+      for (int j = 0; j < 6; ++j) {
+        const mac::WrappedRows r0(u[0], geom, j, k), r1(u[1], geom, j, k), r2(u[2], geom, j, k);
+        for (int i = 0; i < 7; ++i) {
+          const auto wrap = [&](int m) { return geom.periodic[0] ? mac::wrap(m, 7) : m; };
+          const mac::XIndex x{wrap(i - 1), i, wrap(i + 1)};
+          bad += mac::divergence_row(r0, r1, r2, x, geom.inv_h) != mac::divergence_cell(u, geom, {i, j, k});
+        }
+      }
+    EXPECT_EQ(bad, 0) << "combination " << combo;
+  }
+}
+
 TEST(MacOperators, HomogeneousLaplacianIsSymmetricOnEveryLayout) {
   const Grid g({6, 8, 10}, {0.6, 0.8, 1.0}, {W, P, W});
   std::mt19937 rng(2);

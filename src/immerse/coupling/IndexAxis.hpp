@@ -20,8 +20,8 @@ struct IndexAxis {
   /// [0, n] on a periodic axis. Cell centres are at this minus 1/2.
   double face_coordinate(double x) const {
     double xr = x - origin;
-    if (periodic) {
-      xr = std::fmod(xr, length);  // exact, also for coordinates many periods away
+    if (periodic && !(xr >= 0 && xr < length)) {  // (fmod would return xr unchanged inside the box)
+      xr = std::fmod(xr, length);                  // exact, also for coordinates many periods away
       if (xr < 0) xr += length;
     }
     return xr * inv_h;

@@ -99,12 +99,15 @@ void FastSolver::solve(Array3& x, double alpha, double beta) {
   const double norm = normalization_;
 #pragma omp parallel for collapse(2) schedule(static) if (threaded_)
   for (int k = 0; k < mz; ++k)
-    for (int j = 0; j < my; ++j)
+    for (int j = 0; j < my; ++j) {
+      double* const row = b + mx * (j + my * static_cast<std::size_t>(k));
+      const double lyj = ly[j], lzk = lz[k];
+#pragma omp simd
       for (int i = 0; i < mx; ++i) {
-        const double den = (alpha + beta * (lx[i] + ly[j] + lz[k])) * norm;
-        double& v = b[i + mx * (j + my * static_cast<std::size_t>(k))];
-        v = den == 0.0 ? 0.0 : v / den;
+        const double den = (alpha + beta * (lx[i] + lyj + lzk)) * norm;
+        row[i] = den == 0.0 ? 0.0 : row[i] / den;
       }
+    }
   fftw_execute(backward_);
 #pragma omp parallel for collapse(2) schedule(static) if (threaded_)
   for (int k = 0; k < mz; ++k)

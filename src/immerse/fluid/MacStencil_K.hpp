@@ -10,7 +10,14 @@
 //     ghost and first interior value equals the wall velocity u_w.
 // The pressure Laplacian uses the ghost p_g = p_0 (homogeneous Neumann, eq. 11): it is exactly D^MAC G^MAC
 // with G^MAC φ = 0 on the wall faces, so the projection (12) leaves D^MAC u^{n+1} = 0 to round-off.
+//
+// Two forms of each kernel: the generic one at an index (wraps indices, branches on the boundary type at every
+// access; valid everywhere), and a *_row one that reads through an accessor of the neighbouring rows (Strided,
+// or WrappedRows on periodic boundary rows; no branch), valid wherever every value it reads is a stored one,
+// i.e. away from the wall layers (MacGeom::interior_begin/end). Both forms do the same floating-point operations
+// in the same order, so they give bitwise the same result where both apply.
 #include <array>
+#include <cstddef>
 
 #include "immerse/core/Array3.hpp"
 #include "immerse/fluid/MacGeom.hpp"
@@ -66,12 +73,82 @@ inline FaceStencil gather(const Array3& ud, const MacGeom& g, int d, const Index
   return st;
 }
 
+/// Indices i − 1, i, i + 1 along x (wrapped on a periodic axis); X<DX>() picks one.
+struct XIndex {
+  int m, c, p;
+  template <int DX>
+  int at() const {
+    if constexpr (DX < 0) return m;
+    else if constexpr (DX > 0) return p;
+    else return c;
+  }
+};
+
+/// 1 if A == axis: the components of the unit vector e_A.
+constexpr int unit(int A, int axis) { return A == axis ? 1 : 0; }
+
+/// How the row kernels read an Array3 around row (j, k): at<DX, DY, DZ>(x) is the element (x + DX, j + DY, k + DZ).
+/// Two accessors: Strided for rows whose neighbour rows do not wrap (offsets ±1 row, ±1 plane: the common case,
+/// few registers), WrappedRows for the boundary rows of a periodic y or z axis (the nine neighbour rows located
+/// once, wrapped). Along a row the kernels index by XIndex: loop-invariant rows, unit stride, so they vectorize.
+struct Strided {
+  const double* row;
+  std::ptrdiff_t sy, sz;
+  Strided(const Array3& a, const MacGeom&, int j, int k)
+      : row(a.data() + a.index(0, j, k)), sy(a.nx()), sz(static_cast<std::ptrdiff_t>(a.nx()) * a.ny()) {}
+  template <int DX, int DY, int DZ>
+  double at(XIndex x) const {
+    return row[x.at<DX>() + DY * sy + DZ * sz];
+  }
+};
+
+/// Whether row (j, k) has neighbour rows that wrap (it lies on the boundary of a periodic y or z axis): then the
+/// kernels must read through WrappedRows.
+inline bool row_wraps(const MacGeom& g, int j, int k) {
+  return (g.periodic[1] && (j == 0 || j == g.n[1] - 1)) || (g.periodic[2] && (k == 0 || k == g.n[2] - 1));
+}
+
+/// row[dy + 1][dz + 1] points at element (0, j + dy, k + dz), indices wrapped on periodic axes (null if beyond
+/// the array on a wall axis: such a row is never read where the row kernels apply).
+struct WrappedRows {
+  const double* row[3][3];
+  WrappedRows(const Array3& a, const MacGeom& g, int j, int k) {
+    for (int dz = -1; dz <= 1; ++dz)
+      for (int dy = -1; dy <= 1; ++dy) {
+        int jj = j + dy, kk = k + dz;
+        if (g.periodic[1]) jj = wrap(jj, a.ny());
+        if (g.periodic[2]) kk = wrap(kk, a.nz());
+        row[dy + 1][dz + 1] = (jj >= 0 && jj < a.ny() && kk >= 0 && kk < a.nz()) ? a.data() + a.index(0, jj, kk)
+                                                                                 : nullptr;
+      }
+  }
+  template <int DX, int DY, int DZ>
+  double at(XIndex x) const {
+    return row[DY + 1][DZ + 1][x.at<DX>()];
+  }
+};
+
+/// Element (x + DX, j + DY, k + DZ) through the accessor r of row (j, k).
+template <int DX, int DY, int DZ, class R>
+inline double rd(const R& r, XIndex x) {
+  return r.template at<DX, DY, DZ>(x);
+}
+
+/// gather() at a face of u_d whose six neighbours are stored values (rows of u_d around the face's row).
+template <class R>
+inline FaceStencil gather_row(const R& u, XIndex x) {
+  return {rd<0, 0, 0>(u, x),
+          {rd<-1, 0, 0>(u, x), rd<0, -1, 0>(u, x), rd<0, 0, -1>(u, x)},
+          {rd<1, 0, 0>(u, x), rd<0, 1, 0>(u, x), rd<0, 0, 1>(u, x)}};
+}
+
 /// ∇_h² u_d from its stencil.
-inline double laplacian(const FaceStencil& st, const MacGeom& g) {
+inline double laplacian(const FaceStencil& st, double inv_h2) {
   double s = 0;
   for (int e = 0; e < 3; ++e) s += st.minus[e] - 2.0 * st.centre + st.plus[e];
-  return s * g.inv_h2;
+  return s * inv_h2;
 }
+inline double laplacian(const FaceStencil& st, const MacGeom& g) { return laplacian(st, g.inv_h2); }
 
 /// ∇_h² u_d at face q of component d, with the boundary values of g.
 inline double laplacian_face(const Array3& ud, const MacGeom& g, int d, const Index& q) {
@@ -116,11 +193,41 @@ inline double advection_face(const FaceField& u, const MacGeom& g, int d, const 
   return 0.5 * g.inv_h * a;
 }
 
+/// Mean ū_E of the four E-faces around a face of component D ≠ E, in the order of advection_face().
+template <int D, int E, class R>
+inline double mean_face_row(const R& ue, XIndex x) {
+  double sum = rd<0, 0, 0>(ue, x);
+  sum += rd<unit(E, 0), unit(E, 1), unit(E, 2)>(ue, x);
+  sum += rd<unit(E, 0) - unit(D, 0), unit(E, 1) - unit(D, 1), unit(E, 2) - unit(D, 2)>(ue, x);
+  sum += rd<-unit(D, 0), -unit(D, 1), -unit(D, 2)>(ue, x);
+  return 0.25 * sum;
+}
+
+/// advection_face() at a face of component D whose reads are all stored values; st is the stencil of u_D there.
+template <int D, class R>
+inline double advection_row(const FaceStencil& st, const R& u0, const R& u1, const R& u2, XIndex x,
+                            double inv_h) {
+  const double ub0 = D == 0 ? st.centre : mean_face_row<D, 0>(u0, x);
+  const double ub1 = D == 1 ? st.centre : mean_face_row<D, 1>(u1, x);
+  const double ub2 = D == 2 ? st.centre : mean_face_row<D, 2>(u2, x);
+  double a = 0;
+  a += ub0 * (st.plus[0] - st.minus[0]);
+  a += ub1 * (st.plus[1] - st.minus[1]);
+  a += ub2 * (st.plus[2] - st.minus[2]);
+  return 0.5 * inv_h * a;
+}
+
 /// (G^MAC p)_d at face q (an unknown face: never a wall face).
 inline double gradient_face(const Array3& p, const MacGeom& g, int d, const Index& q) {
   Index r = q;
   r[d] = g.periodic[d] ? wrap(q[d] - 1, g.n[d]) : q[d] - 1;
   return (at(p, q) - at(p, r)) * g.inv_h;
+}
+
+/// gradient_face() at an unknown face of component D, from the rows of p.
+template <int D, class R>
+inline double gradient_row(const R& p, XIndex x, double inv_h) {
+  return (rd<0, 0, 0>(p, x) - rd<-unit(D, 0), -unit(D, 1), -unit(D, 2)>(p, x)) * inv_h;
 }
 
 /// (D^MAC u) at cell q, from the face values stored in u (wall faces included).
@@ -132,6 +239,16 @@ inline double divergence_cell(const FaceField& u, const MacGeom& g, const Index&
     s += at(u[d], r) - at(u[d], q);
   }
   return s * g.inv_h;
+}
+
+/// divergence_cell() from the rows of the three components around the cell's row.
+template <class R>
+inline double divergence_row(const R& u0, const R& u1, const R& u2, XIndex x, double inv_h) {
+  double s = 0;
+  s += rd<1, 0, 0>(u0, x) - rd<0, 0, 0>(u0, x);
+  s += rd<0, 1, 0>(u1, x) - rd<0, 0, 0>(u1, x);
+  s += rd<0, 0, 1>(u2, x) - rd<0, 0, 0>(u2, x);
+  return s * inv_h;
 }
 
 /// D^MAC G^MAC φ at cell q: the 7-point Laplacian with ghost φ_g = φ_0 at walls (homogeneous Neumann).
@@ -149,6 +266,26 @@ inline double laplacian_cell_neumann(const Array3& phi, const MacGeom& g, const 
       s += at(phi, r) - c;
     }
   return s * g.inv_h2;
+}
+
+/// Calls kernel(XIndex{i − 1, i, i + 1}) for i in [i0, i1), the neighbours wrapped modulo n on a periodic x
+/// axis: the two ends one by one, the rest in a loop the compiler vectorizes (OpenMP simd). Callers mark the
+/// kernel lambda __attribute__((always_inline)): called from three places, GCC would not inline it otherwise, and
+/// a loop around a call does not vectorize.
+template <class Kernel>
+void along_row(int i0, int i1, int n, bool periodic, Kernel&& kernel) {
+  if (periodic && i0 < i1) {
+    if (i0 == 0) {
+      kernel(XIndex{n - 1, 0, n > 1 ? 1 : 0});
+      i0 = 1;
+    }
+    if (i1 == n && i1 > i0) {
+      kernel(XIndex{n - 2, n - 1, 0});
+      i1 = n - 1;
+    }
+  }
+#pragma omp simd
+  for (int i = i0; i < i1; ++i) kernel(XIndex{i - 1, i, i + 1});
 }
 
 }  // namespace immerse::mac

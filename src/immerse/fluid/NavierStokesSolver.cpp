@@ -1,6 +1,8 @@
 #include "immerse/fluid/NavierStokesSolver.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <cstddef>
 #include <stdexcept>
 
 #include "immerse/core/Error.hpp"
@@ -20,6 +22,118 @@ void ensure_shape(FaceField& f, const Grid& g) {
 
 void ensure_shape(Array3& a, const Grid& g) {
   if (a.shape() != g.cell_shape()) a = Array3(g.n(0), g.n(1), g.n(2));
+}
+
+/// The constants of (9)–(10) at the faces of one component.
+struct RhsCoefficients {
+  double dt_rho, rho, half_mu;  // Δt/ρ, ρ, μ/2
+  double w_now, w_old;          // Adams–Bashforth weights (10)
+  double fb;                    // body force
+};
+
+/// Right-hand side of (9) at one face, with the implicit half of the viscous term on the left (lap: ∇_h² u^n
+/// including the wall values, which so move to the right) and A^{n+1/2} by (10) (adv_old unused on the first step).
+inline double rhs_face(const RhsCoefficients& c, bool first, double un, double a_now, double adv_old, double lap,
+                       double grad_p, double f) {
+  const double a = first ? a_now : c.w_now * a_now + c.w_old * adv_old;
+  return un + c.dt_rho * (-c.rho * a - grad_p + c.half_mu * lap + f + c.fb);
+}
+
+/// (u·∇_h u)^n (into adv) and the right-hand side of (9) (into rhs) along row (j, k) of component D, i in
+/// [i0, i1) (no wall layer), reading through accessor R.
+template <int D, bool First, class R>
+void rhs_row(const MacGeom& g, const FluidState& in, const FaceField& force, const RhsCoefficients& c, Array3& adv,
+             Array3& rhs, int j, int k, int i0, int i1) {
+  // Everything the loop reads in locals: the compiler then sees loop-invariant rows and vectorizes.
+  const R ru(in.u[D], g, j, k), r0(in.u[0], g, j, k), r1(in.u[1], g, j, k), r2(in.u[2], g, j, k), rp(in.p, g, j, k);
+  const std::size_t o = adv.index(0, j, k);
+  const double* const fr = force[D].data() + o;
+  const double* const old = First ? nullptr : in.adv[D].data() + o;  // (not read on the first step)
+  double* const ar = adv.data() + o;
+  double* const rr = rhs.data() + o;
+  const RhsCoefficients cc = c;
+  const double inv_h = g.inv_h, inv_h2 = g.inv_h2;
+  mac::along_row(i0, i1, g.n[0], g.periodic[0], [&](mac::XIndex x) __attribute__((always_inline)) {
+    const int i = x.c;
+    const mac::FaceStencil st = mac::gather_row(ru, x);
+    const double a_now = mac::advection_row<D>(st, r0, r1, r2, x, inv_h);
+    ar[i] = a_now;
+    rr[i] = rhs_face(cc, First, st.centre, a_now, First ? 0.0 : old[i], mac::laplacian(st, inv_h2),
+                     mac::gradient_row<D>(rp, x, inv_h), fr[i]);
+  });
+}
+
+/// Writes (u·∇_h u)^n into adv and the right-hand side of (9) into rhs at every unknown of component D: the row
+/// kernels wherever they apply, the generic kernels in the wall layers.
+template <int D, bool First>
+void build_rhs_t(const MacGeom& g, const FluidState& in, const FaceField& force, const RhsCoefficients& c,
+                 Array3& adv, Array3& rhs) {
+  const Array3 &un = in.u[D], &f = force[D], &p = in.p;
+  for_each_split(
+      g, face_box(g, D), interior_face_box(g, D),
+      [&](int i, int j, int k) {
+        const mac::Index q{i, j, k};
+        const mac::FaceStencil st = mac::gather(un, g, D, q);
+        const double a_now = mac::advection_face(in.u, g, D, q, st);
+        adv(i, j, k) = a_now;
+        const double lap = mac::laplacian(st, g) + mac::wall_source_face(g, D, q);
+        rhs(i, j, k) = rhs_face(c, First, un(i, j, k), a_now, First ? 0.0 : in.adv[D](i, j, k), lap,
+                                mac::gradient_face(p, g, D, q), f(i, j, k));
+      },
+      [&](int j, int k, int i0, int i1) {
+        if (mac::row_wraps(g, j, k))
+          rhs_row<D, First, mac::WrappedRows>(g, in, force, c, adv, rhs, j, k, i0, i1);
+        else
+          rhs_row<D, First, mac::Strided>(g, in, force, c, adv, rhs, j, k, i0, i1);
+      });
+}
+
+template <int D>
+void build_rhs(const MacGeom& g, const FluidState& in, const FaceField& force, const RhsCoefficients& c, bool first,
+               Array3& adv, Array3& rhs) {
+  if (first)
+    build_rhs_t<D, true>(g, in, force, c, adv, rhs);
+  else
+    build_rhs_t<D, false>(g, in, force, c, adv, rhs);
+}
+
+/// D u* (into div) and the right-hand side (ρ/Δt) D u* of (11) (into phi) along row (j, k) of the cells.
+template <class R>
+void divergence_row(const MacGeom& g, const FaceField& us, double rho_dt, Array3& div, Array3& phi, int j, int k,
+                    int i0, int i1) {
+  const R r0(us[0], g, j, k), r1(us[1], g, j, k), r2(us[2], g, j, k);
+  double* const dr = div.data() + div.index(0, j, k);
+  double* const pr = phi.data() + phi.index(0, j, k);
+  const double inv_h = g.inv_h;
+  mac::along_row(i0, i1, g.n[0], g.periodic[0], [&](mac::XIndex x) __attribute__((always_inline)) {
+    const double dv = mac::divergence_row(r0, r1, r2, x, inv_h);
+    dr[x.c] = dv;
+    pr[x.c] = rho_dt * dv;
+  });
+}
+
+/// (12) along row (j, k) of the unknowns of component D: u^{n+1} = u* − (Δt/ρ) G φ.
+template <int D, class R>
+void project_row(const MacGeom& g, const Array3& us, const Array3& phi, Array3& un1, int j, int k, int i0, int i1,
+                 double dt_rho) {
+  const R rphi(phi, g, j, k);
+  const std::size_t o = us.index(0, j, k);
+  const double* const sr = us.data() + o;
+  double* const nr = un1.data() + o;
+  const double inv_h = g.inv_h;
+  mac::along_row(i0, i1, g.n[0], g.periodic[0], [&](mac::XIndex x) __attribute__((always_inline)) {
+    nr[x.c] = sr[x.c] - dt_rho * mac::gradient_row<D>(rphi, x, inv_h);
+  });
+}
+
+template <int D>
+void project(const MacGeom& g, const Array3& us, const Array3& phi, Array3& un1, double dt_rho) {
+  for_each_row(g, face_box(g, D), [&](int j, int k, int i0, int i1) {
+    if (mac::row_wraps(g, j, k))
+      project_row<D, mac::WrappedRows>(g, us, phi, un1, j, k, i0, i1, dt_rho);
+    else
+      project_row<D, mac::Strided>(g, us, phi, un1, j, k, i0, i1, dt_rho);
+  });
 }
 
 }  // namespace
@@ -81,46 +195,46 @@ void NavierStokesSolver::step(const FluidState& in, const FaceField& force, doub
   // (10): Adams–Bashforth weights for a variable step; forward Euler on the first step.
   const bool first = in.step == 0 || in.dt_prev <= 0;
   const double r = first ? 0.0 : dt / in.dt_prev;
-  const double w_now = 1.0 + 0.5 * r, w_old = -0.5 * r;
-  const double dt_rho = dt / rho;
+  const RhsCoefficients coef{dt / rho, rho, 0.5 * mu, 1.0 + 0.5 * r, -0.5 * r, 0.0};
 
   for (int d = 0; d < 3; ++d) {
-    const Array3 &un = in.u[d], &adv_old = in.adv[d], &f = force[d];
-    Array3 &adv = out.adv[d], &rhs = ustar_[d];
-    const double fb = params_.body_force[d];
-    for_each_face(g, d, [&](int i, int j, int k) {
-      const mac::Index q{i, j, k};
-      const mac::FaceStencil st = mac::gather(un, g, d, q);
-      const double a_now = mac::advection_face(in.u, g, d, q, st);
-      adv(i, j, k) = a_now;
-      const double a = first ? a_now : w_now * a_now + w_old * adv_old(i, j, k);
-      // (9) with the implicit half of the viscous term on the left; its wall values move to the right.
-      const double visc = 0.5 * mu * (mac::laplacian(st, g) + mac::wall_source_face(g, d, q));
-      rhs(i, j, k) = un(i, j, k) + dt_rho * (-rho * a - mac::gradient_face(in.p, g, d, q) + visc + f(i, j, k) + fb);
-    });
-    solvers_[d]->solve(rhs, 1.0, -c);
+    RhsCoefficients cd = coef;
+    cd.fb = params_.body_force[d];
+    switch (d) {
+      case 0: build_rhs<0>(g, in, force, cd, first, out.adv[0], ustar_[0]); break;
+      case 1: build_rhs<1>(g, in, force, cd, first, out.adv[1], ustar_[1]); break;
+      default: build_rhs<2>(g, in, force, cd, first, out.adv[2], ustar_[2]); break;
+    }
+    solvers_[d]->solve(ustar_[d], 1.0, -c);
   }
   apply_wall_values(ustar_);
 
   // (11): ∇_h² φ = (ρ/Δt) D u*, Neumann walls.
-  for_each_cell(g, [&](int i, int j, int k) {
-    const double dv = mac::divergence_cell(ustar_, g, {i, j, k});
-    div_(i, j, k) = dv;
-    phi_(i, j, k) = rho / dt * dv;
+  const double rho_dt = rho / dt;
+  for_each_row(g, IndexBox{{0, 0, 0}, g.n}, [&](int j, int k, int i0, int i1) {
+    if (mac::row_wraps(g, j, k))
+      divergence_row<mac::WrappedRows>(g, ustar_, rho_dt, div_, phi_, j, k, i0, i1);
+    else
+      divergence_row<mac::Strided>(g, ustar_, rho_dt, div_, phi_, j, k, i0, i1);
   });
   solvers_[3]->solve(phi_, 0.0, 1.0);
 
   // (12) and (13).
-  for (int d = 0; d < 3; ++d) {
-    const Array3& us = ustar_[d];
-    Array3& un1 = out.u[d];
-    for_each_face(g, d, [&](int i, int j, int k) {
-      un1(i, j, k) = us(i, j, k) - dt_rho * mac::gradient_face(phi_, g, d, {i, j, k});
-    });
-  }
+  const double dt_rho = coef.dt_rho;
+  project<0>(g, ustar_[0], phi_, out.u[0], dt_rho);
+  project<1>(g, ustar_[1], phi_, out.u[1], dt_rho);
+  project<2>(g, ustar_[2], phi_, out.u[2], dt_rho);
   apply_wall_values(out.u);
-  for_each_cell(
-      g, [&](int i, int j, int k) { out.p(i, j, k) = in.p(i, j, k) + phi_(i, j, k) - 0.5 * mu * div_(i, j, k); });
+  {
+    const double half_mu = coef.half_mu;
+    const double* p0 = in.p.data();
+    const double* ph = phi_.data();
+    const double* dv = div_.data();
+    double* p1 = out.p.data();
+    const long cells = static_cast<long>(out.p.size());
+#pragma omp parallel for simd schedule(static) if (g.threaded())
+    for (long n = 0; n < cells; ++n) p1[n] = p0[n] + ph[n] - half_mu * dv[n];
+  }
 
   out.dt_prev = dt;
   out.step = in.step + 1;
