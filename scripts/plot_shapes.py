@@ -99,14 +99,18 @@ def frames_by_force(text, run_dir, times, files):
         if col not in diag:
             pc.fail(f"{run_dir}/diagnostics.csv has no column {col!r}: not an rbc_stretch run")
     # The steady step of force i: the first row after that of force i-1 whose diameters equal stretch.csv's
-    # (both are written from the same positions at full precision).
+    # (both are written from the same positions at full precision); of a run of equal rows (a cell at rest under
+    # zero force), the last.
     ends, start = [], 0
     for a, t in zip(axial, transverse):
-        hits = np.nonzero((diag["axial_um"][start:] == a) & (diag["transverse_um"][start:] == t))[0]
+        same = (diag["axial_um"] == a) & (diag["transverse_um"] == t)
+        hits = np.nonzero(same[start:])[0]
         if hits.size == 0:
             pc.fail(f"{run_dir}: no row of diagnostics.csv has the steady diameters {a:g}, {t:g} um of stretch.csv "
                     f"(diagnostics_every > 1?)")
         start += int(hits[0])
+        while start + 1 < same.size and same[start + 1]:
+            start += 1
         ends.append(diag["time"][start])
         start += 1
     frames, labels = [], []

@@ -28,7 +28,9 @@ def read_experiment(path):
     """The measured diameters: a dict column -> numpy array (lines starting with '#' are comments)."""
     if not os.path.isfile(path):
         pc.fail(f"--experiment {path}: file not found")
-    data = np.genfromtxt(path, delimiter=",", names=True, comments="#", ndmin=1)
+    with open(path) as f:
+        lines = [line for line in f if not line.lstrip().startswith("#")]
+    data = np.genfromtxt(lines, delimiter=",", names=True, ndmin=1)
     missing = [c for c in EXPERIMENT_COLUMNS if c not in (data.dtype.names or ())]
     if data.size == 0 or missing:
         pc.fail(f"--experiment {path}: expected a header with columns {','.join(EXPERIMENT_COLUMNS)} and rows; "
@@ -77,7 +79,7 @@ def main():
     ax.plot([], [], "-", color="C3", lw=6, alpha=0.6, label="transverse diameter")
     ax.set_xlabel("stretching force (pN)")
     ax.set_ylabel("diameter ($\\mu$m)")
-    ax.set_xlim(left=0)
+    ax.set_xlim(left=-5)
     ax.set_ylim(bottom=0)
     ax.set_title("Red blood cell stretched by optical tweezers")
     ax.grid(alpha=0.3)

@@ -11,7 +11,8 @@ spherical neo-Hookean capsule without bending, viscosity ratio 1) as a dashed li
 not apply to oblate or bending capsules and the paper draws none there. When the runs differ in kappa_B_hat, the
 line width grows with kappa_B_hat, as in Fig. 11. --panel-per-G draws one panel per value of G (Fig. 11 a, b).
 With --theta a second row of panels shows the inclination theta (for capsule_shear against its small-deformation
-value pi/4 - 97G/16). Default PNG: taylor.png in the first RUN_DIR.
+value pi/4 - 97G/16). A run that stopped before scenario.kt_end (e.g. an element inverted) says so in the legend.
+Default PNG: taylor.png in the first RUN_DIR.
 """
 import argparse
 import os
@@ -73,6 +74,10 @@ def main():
             theta = pc.membrane_column(diag, "theta", args.membrane)
             color, lw = f"C{i}", width[r["kappa"]]
             label = pc.label_of(r["cfg"], r["dir"])
+            sc = r["cfg"]["scenario"]
+            if kt[-1] < sc["kt_end"] - 0.5 * sc["k_dt"]:  # the run stopped early (e.g. a mesh element inverted)
+                label += f" (run stopped at k t = {kt[-1]:.3g})"
+                print(f"warning: {r['dir']} ends at k t = {kt[-1]:.4g}, before scenario.kt_end = {sc['kt_end']:g}")
             ax.plot(kt, D, "-", color=color, lw=lw, label=label)
             if ax_theta is not None:
                 ax_theta.plot(kt, theta, "-", color=color, lw=lw, label=label)
