@@ -204,7 +204,10 @@ def main():
         frames = frames_by_index(args.frames, len(files))
     try:
         elev, azim = (float(s) for s in args.view.split(","))
-        panel = None if args.panel is None else tuple(float(s) for s in args.panel.split(","))
+        panel = None
+        if args.panel is not None:
+            panel_w, panel_h = (float(s) for s in args.panel.split(","))
+            panel = (panel_w, panel_h)
     except ValueError:
         pc.fail(f"--view {args.view!r} / --panel {args.panel!r}: expected two comma-separated numbers each")
     if args.columns is not None and args.columns < 1:
