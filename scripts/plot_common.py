@@ -85,7 +85,7 @@ def label_of(cfg, run_dir):
         return ", ".join(parts)
     if kind == "oscillating_membrane":
         return f"$\\mu$ = {cfg['fluid']['mu']:g}"
-    if kind == "rbc_stretch":
+    if kind in ("rbc_stretch", "rbc_channel"):
         return f"$\\mu_0$ = {sc['mu0'] * 1e6:g} $\\mu$N/m"
     return os.path.basename(os.path.normpath(run_dir))
 

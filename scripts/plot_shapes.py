@@ -17,9 +17,10 @@ equal axes. Which frames:
                    frame under that force is drawn and its diameters are printed beside the steady ones.
 --box draws the outline of the computational box and uses it as the axes' extent (Fig. 15: the cells in the
 channel); membranes that left the box through a periodic side are shifted back by whole periods (by their
-centroid). Default view: a 3-D panel seen from --view 15,-75 (elevation, azimuth in degrees; 0,-90 looks along +y
-with x to the right). --side x|y|z instead draws a flat, exactly scaled 2-D panel seen along that axis (x: y to
-the right and z up; y: x to the right, z up; z: x to the right, y up), faces painted far to near.
+centroid); a --side panel is clipped to the box and draws the parts beyond a periodic side again at the opposite
+side. Default view: a 3-D panel seen from --view 15,-75 (elevation, azimuth in degrees; 0,-90 looks along +y with
+x to the right). --side x|y|z instead draws a flat, exactly scaled 2-D panel seen along that axis (x: y to the
+right and z up; y: x to the right, z up; z: x to the right, y up), faces painted far to near.
 Default PNG: RUN_DIR/shapes.png.
 """
 import argparse
@@ -152,6 +153,22 @@ def into_box(nodes, lo, hi, periodic):
     return nodes - shift
 
 
+def periodic_copies(nodes, lo, hi, periodic):
+    """The membrane and, where it sticks out through a periodic side, its images one period over."""
+    copies = [nodes]
+    for d in np.nonzero(periodic)[0]:
+        shift = np.zeros(3)
+        shift[d] = hi[d] - lo[d]
+        extra = []
+        for x in copies:
+            if x[:, d].min() < lo[d]:
+                extra.append(x + shift)
+            if x[:, d].max() > hi[d]:
+                extra.append(x - shift)
+        copies += extra
+    return copies
+
+
 def draw_box(ax, lo, hi):
     """The 12 edges of the box."""
     corners = np.array([[x, y, z] for x in (lo[0], hi[0]) for y in (lo[1], hi[1]) for z in (lo[2], hi[2])])
@@ -222,6 +239,8 @@ def main():
         time, membranes = read_membranes(files[i], args.membrane)
         if args.box:
             membranes = [(m, into_box(x, lo, hi, periodic), t) for m, x, t in membranes]
+            if args.side is not None:  # a 2-D panel is clipped to the box: draw the images across periodic sides
+                membranes = [(m, c, t) for m, x, t in membranes for c in periodic_copies(x, lo, hi, periodic)]
         data.append((i, time, [(m, x * scale, t) for m, x, t in membranes]))
     if args.box:
         lower, upper = lo * scale, hi * scale
@@ -243,10 +262,10 @@ def main():
         eye["xyz".index(args.side)] = sign
         extent = upper - lower
         width = 6.5 if extent[h_axis] >= extent[v_axis] else 3.5
-        panel_w, panel_h = panel or (width, width * extent[v_axis] / extent[h_axis] + 0.8)
+        panel_w, panel_h = panel or (width, width * extent[v_axis] / extent[h_axis] + 1.1)
     light = eye + 0.6 * np.array([0.0, 0.0, 1.0] if args.side != "z" else [0.0, 1.0, 0.0])
     light /= np.linalg.norm(light)
-    count = max(len(ms) for _, _, ms in data)
+    count = max(len({m for m, _, _ in ms}) for _, _, ms in data)
     several = count > 1
     palette = matplotlib.colormaps["tab10" if count <= 10 else "tab20"]
 
@@ -281,11 +300,14 @@ def main():
             ax = fig.add_subplot(nrows, ncols, n + 1)
             depth = polys[:, :, "xyz".index(args.side)].mean(axis=1) * sign
             order = np.argsort(depth, kind="stable")  # far (small depth * sign) first
-            ax.add_collection(PolyCollection(polys[order][:, :, [h_axis, v_axis]], facecolors=colors[order],
-                                             edgecolors=edges, linewidths=0.15))
+            faces = PolyCollection(polys[order][:, :, [h_axis, v_axis]], facecolors=colors[order],
+                                   edgecolors=edges, linewidths=0.15)
+            ax.add_collection(faces)
             if args.box:
-                ax.add_patch(plt.Rectangle((lower[h_axis], lower[v_axis]), upper[h_axis] - lower[h_axis],
-                                           upper[v_axis] - lower[v_axis], fill=False, color="k", lw=1))
+                outline = plt.Rectangle((lower[h_axis], lower[v_axis]), upper[h_axis] - lower[h_axis],
+                                        upper[v_axis] - lower[v_axis], fill=False, color="k", lw=1)
+                ax.add_patch(outline)
+                faces.set_clip_path(outline)
             pad = 0.02 * (upper - lower).max()
             ax.set_xlim(lower[h_axis] - pad, upper[h_axis] + pad)
             ax.set_ylim(lower[v_axis] - pad, upper[v_axis] + pad)
