@@ -118,7 +118,8 @@ def frames_by_force(text, run_dir, times, files):
     for F in pc.parse_numbers("--forces", text):
         match = np.nonzero(np.isclose(force, F, rtol=1e-6, atol=1e-9))[0]
         if match.size == 0:
-            pc.fail(f"--forces: {F:g} pN is not a force of {run_dir}/stretch.csv ({', '.join(f'{x:g}' for x in force)})")
+            listed = ", ".join(f"{x:g}" for x in force)
+            pc.fail(f"--forces: {F:g} pN is not a force of {run_dir}/stretch.csv ({listed})")
         i = int(match[0])
         t_end, t_begin = ends[i], (ends[i - 1] if i > 0 else -np.inf)
         under = np.nonzero((times > t_begin + 1e-12 * abs(t_end)) & (times <= t_end * (1 + 1e-12)))[0]
