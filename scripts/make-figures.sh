@@ -6,7 +6,7 @@
 #   capsule_shear_quick at G = 0.0125, 0.05 and 0.1                       (§4.2.1, Fig. 7)
 #   oblate_shear_quick at b/a = 0.9 (G = 0.1, 0.2) and b/a = 0.5 (G = 0.2, level 3)  (§4.2.2, Figs. 8-9)
 #   bending_shear_quick at G = 0.05, kappa_B_hat = 0, 0.01, 0.025, 0.0375    (§4.2.3, Fig. 11a)
-#   rbc_stretch_quick at mu0 = 4.8, 7.3, 10 uN/m, forces 0, 38.9, 110, 194 pN (§4.3,   Figs. 13-14)
+#   rbc_stretch_quick at mu0 = 7.3 and 10 uN/m, forces 0, 38.9, 110, 194 pN  (§4.3,   Figs. 13-14)
 # into out/figures/, then plots with Debian's matplotlib (/usr/bin/python3). Each plot script prints its key numbers.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -57,7 +57,7 @@ for kappa in 0 0.01 0.025 0.0375; do
   start bending_shear_quick "$runs/bending_G0.05_kB$kappa" --set scenario.G=0.05 --set scenario.kappa_B_hat=$kappa
 done
 # Fig. 14 draws the cell at the steady state of each force: frames at every step (membranes only) for mu0 = 7.3.
-for mu0 in 4.8 7.3 10; do
+for mu0 in 7.3 10; do
   frames=()
   [[ $mu0 == 7.3 ]] && frames=(--set output.fields_every=1 --set output.fluid_fields=false)
   start rbc_stretch_quick "$runs/rbc_mu0_$mu0" --set scenario.mu0=${mu0}e-6 \
@@ -74,5 +74,5 @@ $python scripts/plot_taylor.py "$runs"/shear_G0.0125 "$runs"/shear_G0.05 "$runs"
 $python scripts/plot_taylor.py "$runs"/oblate_ba0.9_G0.1 "$runs"/oblate_ba0.9_G0.2 -o "$figs/fig8_oblate_ba0.9.png"
 $python scripts/plot_taylor.py "$runs"/oblate_ba0.5_G0.2 -o "$figs/fig9_oblate_ba0.5.png"
 $python scripts/plot_taylor.py "$runs"/bending_G0.05_kB* -o "$figs/fig11_bending_G0.05.png"
-$python scripts/plot_stretch.py "$runs"/rbc_mu0_4.8 "$runs"/rbc_mu0_7.3 "$runs"/rbc_mu0_10 -o "$figs/fig13_stretch.png"
+$python scripts/plot_stretch.py "$runs"/rbc_mu0_7.3 "$runs"/rbc_mu0_10 -o "$figs/fig13_stretch.png"
 $python scripts/plot_shapes.py "$runs"/rbc_mu0_7.3 --forces 0,38.9,110,194 --view 35,-60 -o "$figs/fig14_rbc_shapes.png"

@@ -4,7 +4,8 @@
 Usage: /usr/bin/python3 scripts/plot_stretch.py RUN_DIR [RUN_DIR ...] [-o PNG] [--experiment CSV | --no-experiment]
 Each RUN_DIR is an rbc_stretch run (one per shear modulus scenario.mu0, read from its config.resolved.toml); its
 stretch.csv (force_pN, axial_um, transverse_um: the steady diameters at each force of the sweep) is drawn as one
-line style per run, as in the paper (dotted, solid, dash-dotted for increasing mu0), axial and transverse alike.
+line style per run, axial and transverse alike: the paper's (dotted, solid, dash-dotted for mu0 = 4.8, 7.3, 10
+uN/m) when every run has one of those moduli, else dotted, solid, dash-dotted, dashed in order of increasing mu0.
 The optical-tweezers measurements of Mills et al. (2004), the paper's ref. [32], are drawn beside as symbols with
 error bars, from scenarios/rbc_stretch_mills2004.csv (see the source stated in that file) unless --no-experiment or
 another --experiment CSV with the same columns is given. Default PNG: stretch.png in the first RUN_DIR.
@@ -22,6 +23,7 @@ DEFAULT_EXPERIMENT = os.path.join(os.path.dirname(os.path.abspath(__file__)), ".
 EXPERIMENT_COLUMNS = ("force_pN", "axial_um", "axial_lo_um", "axial_hi_um",
                       "transverse_um", "transverse_lo_um", "transverse_hi_um")
 STYLES = [":", "-", "-.", "--"]
+PAPER_STYLES = {4.8: ":", 7.3: "-", 10.0: "-."}  # Fig. 13: dotted, solid, dash-dotted for mu0 = 4.8, 7.3, 10 uN/m
 
 
 def read_experiment(path):
@@ -57,10 +59,11 @@ def main():
     if len(runs) > len(STYLES):
         pc.fail(f"{len(runs)} runs given: at most {len(STYLES)} (one line style each)")
 
+    paper = all(round(mu0 * 1e6, 6) in PAPER_STYLES for mu0, _, _ in runs)
     fig, ax = plt.subplots(figsize=(6.4, 4.8))
     for i, (mu0, run_dir, cfg) in enumerate(runs):
         force, axial, transverse = pc.read_stretch(run_dir)
-        style = STYLES[i]
+        style = PAPER_STYLES[round(mu0 * 1e6, 6)] if paper else STYLES[i]
         ax.plot(force, axial, style, color="C0", lw=1.8, marker=".", ms=5)
         ax.plot(force, transverse, style, color="C3", lw=1.8, marker=".", ms=5)
         ax.plot([], [], style, color="k", lw=1.8, label=f"simulation, {pc.label_of(cfg, run_dir)}")
