@@ -246,10 +246,10 @@ def main():
     if args.box:
         lower, upper = lo * scale, hi * scale
     else:
+        # The bounding box of every drawn node, padded; the panels keep equal scales along x, y and z.
         everything = np.vstack([x for _, _, ms in data for _, x, _ in ms])
-        centre = 0.5 * (everything.min(axis=0) + everything.max(axis=0))
-        half = 0.5 * (everything.max(axis=0) - everything.min(axis=0)).max() * 1.05
-        lower, upper = centre - half, centre + half
+        pad = 0.04 * (everything.max(axis=0) - everything.min(axis=0)).max()
+        lower, upper = everything.min(axis=0) - pad, everything.max(axis=0) + pad
 
     shear = kind in pc.SHEAR_KINDS
     k = pc.shear_rate(cfg) if shear else 0.0
