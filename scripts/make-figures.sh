@@ -78,6 +78,6 @@ $python scripts/plot_semi_axes.py "$runs/osc_mu0.1" -o "$figs/fig5_semi_axes_mu0
 $python scripts/plot_taylor.py "$runs"/shear_G0.0125 "$runs"/shear_G0.05 "$runs"/shear_G0.1 -o "$figs/fig7_taylor.png"
 $python scripts/plot_taylor.py "$runs"/oblate_ba0.9_G0.1 "$runs"/oblate_ba0.9_G0.2 -o "$figs/fig8_oblate_ba0.9.png"
 $python scripts/plot_taylor.py "$runs"/oblate_ba0.5_G0.2 -o "$figs/fig9_oblate_ba0.5.png"
-$python scripts/plot_taylor.py "$runs"/bending_G0.05_kB* -o "$figs/fig11_bending_G0.05.png"
+$python scripts/plot_taylor.py "$runs"/bending_G0.05_kB{0,0.01,0.025,0.0375} -o "$figs/fig11_bending_G0.05.png"
 $python scripts/plot_stretch.py "$runs"/rbc_mu0_7.3 "$runs"/rbc_mu0_10 -o "$figs/fig13_stretch.png"
 $python scripts/plot_shapes.py "$runs"/rbc_mu0_7.3 --forces 0,38.9,110,194 --view 35,-60 -o "$figs/fig14_rbc_shapes.png"
