@@ -83,7 +83,8 @@ def main():
                 ax_theta.plot(kt, theta, "-", color=color, lw=lw, label=label)
             # The oblate capsule's D_xz oscillates: report the mean and range over the second half of the run.
             late = kt >= 0.5 * kt[-1]
-            line = (f"{r['dir']}: {label.replace('$', '').replace(chr(92) + 'hat{' + chr(92) + 'kappa}_B', 'kappa_B_hat')}, k = {r['k']:g} 1/s, kt_end = {kt[-1]:.3g}: "
+            plain = label.replace("$", "").replace("\\hat{\\kappa}_B", "kappa_B_hat")
+            line = (f"{r['dir']}: {plain}, k = {r['k']:g} 1/s, kt_end = {kt[-1]:.3g}: "
                     f"D_xz = {D[-1]:.4f} (second half: mean {D[late].mean():.4f}, min {D[late].min():.4f}, "
                     f"max {D[late].max():.4f}), theta = {theta[-1]:.4f} rad")
             if r["kind"] == "capsule_shear":
