@@ -64,11 +64,49 @@ def shear_rate(cfg):
     return (b["z_upper_velocity"][0] - b["z_lower_velocity"][0]) / cfg["domain"]["Lz"]
 
 
+SHEAR_KINDS = ("capsule_shear", "oblate_shear", "bending_shear")
+
+
+def scenario_kind(cfg):
+    """scenario.kind of a resolved configuration ("none" when absent)."""
+    return cfg.get("scenario", {}).get("kind", "none")
+
+
 def label_of(cfg, run_dir):
-    """A short legend label for a run."""
-    kind = cfg.get("scenario", {}).get("kind", "none")
-    if kind in ("capsule_shear", "oblate_shear", "bending_shear"):
-        return f"G = {cfg['scenario']['G']:g}"
+    """A short legend label for a run: its nondimensional groups (G, b/a, kappa_B_hat; mu; mu0)."""
+    kind = scenario_kind(cfg)
+    sc = cfg.get("scenario", {})
+    if kind in SHEAR_KINDS:
+        parts = [f"G = {sc['G']:g}"]
+        if kind == "oblate_shear":
+            parts.append(f"b/a = {sc['aspect_ratio']:g}")
+        if kind == "bending_shear":
+            parts.append(f"$\\hat{{\\kappa}}_B$ = {sc['kappa_B_hat']:g}")
+        return ", ".join(parts)
     if kind == "oscillating_membrane":
         return f"$\\mu$ = {cfg['fluid']['mu']:g}"
+    if kind in ("rbc_stretch", "rbc_channel"):
+        return f"$\\mu_0$ = {sc['mu0'] * 1e6:g} $\\mu$N/m"
     return os.path.basename(os.path.normpath(run_dir))
+
+
+def parse_numbers(option, text):
+    """Comma-separated numbers of a command-line option, e.g. --times 0,0.5,1."""
+    try:
+        return [float(s) for s in text.split(",")]
+    except ValueError:
+        fail(f"{option} {text!r}: expected comma-separated numbers such as 0,0.5,1")
+
+
+def read_stretch(run_dir):
+    """DIR/stretch.csv of an rbc_stretch run as (force_pN, axial_um, transverse_um) numpy arrays."""
+    path = os.path.join(run_dir, "stretch.csv")
+    if not os.path.isfile(path):
+        fail(f"{path} not found: is {run_dir} the --out directory of an rbc_stretch run?")
+    data = np.genfromtxt(path, delimiter=",", names=True, ndmin=1)
+    if data.size == 0:
+        fail(f"{path} has no rows (the sweep stopped before its first force was steady)")
+    for name in ("force_pN", "axial_um", "transverse_um"):
+        if name not in data.dtype.names:
+            fail(f"{path} has no column {name!r}")
+    return tuple(np.asarray(data[n], dtype=float) for n in ("force_pN", "axial_um", "transverse_um"))

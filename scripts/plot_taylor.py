@@ -1,11 +1,17 @@
 #!/usr/bin/python3
-"""Fig. 7 of the paper: the Taylor shape parameter D_xz = (L - B)/(L + B) vs k t, for one or several runs.
+"""Figs. 7, 8-9 and 11 of the paper: the Taylor shape parameter D_xz = (L - B)/(L + B) vs k t, for one or several runs.
 
 Usage: /usr/bin/python3 scripts/plot_taylor.py RUN_DIR [RUN_DIR ...] [-o PNG] [--membrane I] [--theta]
-The shear rate is k = (boundary.z_upper_velocity[0] - boundary.z_lower_velocity[0]) / domain.Lz and
-G = scenario.G, both from each run's config.resolved.toml. Each run gets the small-deformation theory
-D = 25G/4 (numerics notes; neo-Hookean, viscosity ratio 1) as a dashed line of its colour. With --theta a second
-panel shows the inclination theta against its small-deformation value pi/4 - 97G/16.
+                                               [--panel-per-G] [--title TEXT]
+Runs of the shear scenarios capsule_shear (Fig. 7), oblate_shear (Figs. 8-9) and bending_shear (Fig. 11). From each
+run's config.resolved.toml: the shear rate k = (boundary.z_upper_velocity[0] - boundary.z_lower_velocity[0]) /
+domain.Lz and the legend (scenario.G; scenario.aspect_ratio = b/a for oblate_shear; scenario.kappa_B_hat for
+bending_shear). Each capsule_shear run gets the small-deformation theory D = 25G/4 (numerics notes; initially
+spherical neo-Hookean capsule without bending, viscosity ratio 1) as a dashed line of its colour; the theory does
+not apply to oblate or bending capsules and the paper draws none there. When the runs differ in kappa_B_hat, the
+line width grows with kappa_B_hat, as in Fig. 11. --panel-per-G draws one panel per value of G (Fig. 11 a, b).
+With --theta a second row of panels shows the inclination theta (for capsule_shear against its small-deformation
+value pi/4 - 97G/16). A run that stopped before scenario.kt_end (e.g. an element inverted) says so in the legend.
 Default PNG: taylor.png in the first RUN_DIR.
 """
 import argparse
@@ -16,60 +22,101 @@ import numpy as np
 
 import plot_common as pc
 
+TITLES = {
+    "capsule_shear": "Initially spherical neo-Hookean capsule in simple shear",
+    "oblate_shear": "Oblate spheroidal capsule in simple shear",
+    "bending_shear": "Spherical capsule with bending stiffness in simple shear",
+}
+
+
+def read_run(run_dir):
+    cfg = pc.read_config(run_dir)
+    kind = pc.scenario_kind(cfg)
+    if kind not in pc.SHEAR_KINDS:
+        pc.fail(f"{run_dir}: scenario.kind is {kind!r}, expected one of {', '.join(pc.SHEAR_KINDS)}")
+    k = pc.shear_rate(cfg)
+    if k == 0.0:
+        pc.fail(f"{run_dir}: the z walls do not move (k = 0): not a shear run")
+    sc = cfg["scenario"]
+    return {"dir": run_dir, "cfg": cfg, "kind": kind, "k": k, "G": sc["G"],
+            "ba": sc["aspect_ratio"] if kind == "oblate_shear" else 1.0,
+            "kappa": sc["kappa_B_hat"] if kind == "bending_shear" else 0.0}
+
 
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("run_dirs", nargs="+", metavar="RUN_DIR")
     parser.add_argument("-o", "--output", help="PNG to write (default taylor.png in the first RUN_DIR)")
     parser.add_argument("--membrane", type=int, default=0, help="membrane index (default 0)")
-    parser.add_argument("--theta", action="store_true", help="add a panel with the inclination theta")
+    parser.add_argument("--theta", action="store_true", help="add panels with the inclination theta")
+    parser.add_argument("--panel-per-G", action="store_true", help="one panel per value of G (Fig. 11 a, b)")
+    parser.add_argument("--title", help="figure title (default: from the scenario kind)")
     args = parser.parse_args()
 
-    runs = []
-    for run_dir in args.run_dirs:
-        cfg = pc.read_config(run_dir)
-        if "G" not in cfg.get("scenario", {}):
-            pc.fail(f"{run_dir}: config.resolved.toml has no scenario.G")
-        k = pc.shear_rate(cfg)
-        if k == 0.0:
-            pc.fail(f"{run_dir}: the z walls do not move (k = 0): not a shear run")
-        runs.append((cfg["scenario"]["G"], run_dir, cfg, k))
-    runs.sort(key=lambda r: r[0])
+    runs = sorted((read_run(d) for d in args.run_dirs), key=lambda r: (r["G"], -r["ba"], r["kappa"]))
+    kinds = sorted({r["kind"] for r in runs})
+    title = args.title or (TITLES[kinds[0]] if len(kinds) == 1 else "Capsules in simple shear")
+    groups = sorted({r["G"] for r in runs}) if args.panel_per_G else [None]
+    # Line width grows with kappa_B_hat (Fig. 11): rank among the distinct values in the plot.
+    kappas = sorted({r["kappa"] for r in runs})
+    width = {kp: 1.2 + 1.1 * i for i, kp in enumerate(kappas)} if len(kappas) > 1 else {kappas[0]: 1.5}
 
-    if args.theta:
-        fig, (ax, ax_theta) = plt.subplots(1, 2, figsize=(11.0, 4.4))
-    else:
-        fig, ax = plt.subplots(figsize=(6.4, 4.4))
-    for i, (G, run_dir, cfg, k) in enumerate(runs):
-        diag = pc.read_diagnostics(run_dir)
-        kt = k * diag["time"]
-        D = pc.membrane_column(diag, "D_xz", args.membrane)
-        theta = pc.membrane_column(diag, "theta", args.membrane)
-        color = f"C{i}"
-        ax.plot(kt, D, "-", color=color, lw=1.5, label=f"G = {G:g}")
-        ax.axhline(25.0 * G / 4.0, color=color, ls="--", lw=1)
-        if args.theta:
-            ax_theta.plot(kt, theta, "-", color=color, lw=1, label=f"G = {G:g}")
-            ax_theta.axhline(np.pi / 4 - 97.0 * G / 16.0, color=color, ls="--", lw=1)
-        print(f"{run_dir}: G = {G:g}, k = {k:g} 1/s, kt_end = {kt[-1]:.3g}: D_xz = {D[-1]:.4f} "
-              f"(25G/4 = {25 * G / 4:.4f}, ratio {D[-1] / (25 * G / 4):.3f}), theta = {theta[-1]:.4f} rad "
-              f"(pi/4 - 97G/16 = {np.pi / 4 - 97 * G / 16:.4f})")
-    ax.plot([], [], "k--", lw=1, label="small-deformation theory 25G/4")
-    ax.set_xlabel("dimensionless time k t")
-    ax.set_ylabel("Taylor parameter $D_{xz}$")
-    ax.set_xlim(left=0)
-    ax.set_ylim(bottom=0)
-    ax.set_title("Initially spherical neo-Hookean capsule in simple shear")
-    ax.grid(alpha=0.3)
-    ax.legend(loc="lower right", fontsize="small")
-    if args.theta:
-        ax_theta.plot([], [], "k--", lw=1, label="theory $\\pi/4 - 97G/16$")
-        ax_theta.set_xlabel("dimensionless time k t")
-        ax_theta.set_ylabel("inclination $\\theta$ (rad)")
-        ax_theta.set_xlim(left=0)
-        ax_theta.set_title("Inclination of the long axis to the flow")
-        ax_theta.grid(alpha=0.3)
-        ax_theta.legend(fontsize="small")
+    ncols, nrows = len(groups), 2 if args.theta else 1
+    fig, axes = plt.subplots(nrows, ncols, figsize=(0.6 + 5.8 * ncols, 4.2 * nrows), squeeze=False)
+    for col, group in enumerate(groups):
+        ax, ax_theta = axes[0][col], (axes[1][col] if args.theta else None)
+        members = [r for r in runs if group is None or r["G"] == group]
+        theory = False
+        for i, r in enumerate(members):
+            diag = pc.read_diagnostics(r["dir"])
+            kt = r["k"] * diag["time"]
+            D = pc.membrane_column(diag, "D_xz", args.membrane)
+            theta = pc.membrane_column(diag, "theta", args.membrane)
+            color, lw = f"C{i}", width[r["kappa"]]
+            label = pc.label_of(r["cfg"], r["dir"])
+            sc = r["cfg"]["scenario"]
+            if kt[-1] < sc["kt_end"] - 0.5 * sc["k_dt"]:  # the run stopped early (e.g. a mesh element inverted)
+                label += f" (run stopped at k t = {kt[-1]:.3g})"
+                print(f"warning: {r['dir']} ends at k t = {kt[-1]:.4g}, before scenario.kt_end = {sc['kt_end']:g}")
+            ax.plot(kt, D, "-", color=color, lw=lw, label=label)
+            if ax_theta is not None:
+                ax_theta.plot(kt, theta, "-", color=color, lw=lw, label=label)
+            # The oblate capsule's D_xz oscillates: report the mean and range over the second half of the run.
+            late = kt >= 0.5 * kt[-1]
+            plain = label.replace("$", "").replace("\\hat{\\kappa}_B", "kappa_B_hat")
+            line = (f"{r['dir']}: {plain}, k = {r['k']:g} 1/s, kt_end = {kt[-1]:.3g}: "
+                    f"D_xz = {D[-1]:.4f} (second half: mean {D[late].mean():.4f}, min {D[late].min():.4f}, "
+                    f"max {D[late].max():.4f}), theta = {theta[-1]:.4f} rad")
+            if r["kind"] == "capsule_shear":
+                theory = True
+                G = r["G"]
+                ax.axhline(25.0 * G / 4.0, color=color, ls="--", lw=1)
+                if ax_theta is not None:
+                    ax_theta.axhline(np.pi / 4 - 97.0 * G / 16.0, color=color, ls="--", lw=1)
+                line += (f"; theory 25G/4 = {25 * G / 4:.4f} (ratio {D[-1] / (25 * G / 4):.3f}), "
+                         f"pi/4 - 97G/16 = {np.pi / 4 - 97 * G / 16:.4f}")
+            print(line)
+        if theory:
+            ax.plot([], [], "k--", lw=1, label="small-deformation theory 25G/4")
+        ax.set_xlabel("dimensionless time k t")
+        ax.set_ylabel("Taylor parameter $D_{xz}$")
+        ax.set_xlim(left=0)
+        ax.set_ylim(bottom=0)
+        ax.set_title(title if group is None else f"({chr(ord('a') + col)}) G = {group:g}",
+                     fontsize=11 if group is None else 10)
+        ax.grid(alpha=0.3)
+        ax.legend(loc="lower right", fontsize="small")
+        if ax_theta is not None:
+            if theory:
+                ax_theta.plot([], [], "k--", lw=1, label="theory $\\pi/4 - 97G/16$")
+            ax_theta.set_xlabel("dimensionless time k t")
+            ax_theta.set_ylabel("inclination $\\theta$ (rad)")
+            ax_theta.set_xlim(left=0)
+            ax_theta.set_title("Inclination of the long axis to the flow", fontsize=10)
+            ax_theta.grid(alpha=0.3)
+            ax_theta.legend(fontsize="small")
+    if args.panel_per_G:
+        fig.suptitle(title, fontsize=11)
     fig.tight_layout()
     out = args.output or os.path.join(args.run_dirs[0], "taylor.png")
     fig.savefig(out, dpi=pc.DPI)
