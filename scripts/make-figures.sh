@@ -68,6 +68,8 @@ for mu0 in 7.3 10; do
     --set "scenario.forces_pN=[0, 38.9, 110, 194]" --set scenario.steady_tol=5e-3 \
     --set scenario.max_relaxation_times=8 "${frames[@]}"
 done
+# Fig. 15: the 32 cells of the quick channel at t = 0 and t = 0.05 s (the longest of these runs).
+start rbc_channel_quick "$runs/channel" --set output.fluid_fields=false
 wait
 if compgen -G "$runs/*.failed" >/dev/null; then echo "some runs failed: no figures written"; exit 1; fi
 
@@ -81,3 +83,4 @@ $python scripts/plot_taylor.py "$runs"/oblate_ba0.5_G0.2 -o "$figs/fig9_oblate_b
 $python scripts/plot_taylor.py "$runs"/bending_G0.05_kB{0,0.01,0.025,0.0375} -o "$figs/fig11_bending_G0.05.png"
 $python scripts/plot_stretch.py "$runs"/rbc_mu0_7.3 "$runs"/rbc_mu0_10 -o "$figs/fig13_stretch.png"
 $python scripts/plot_shapes.py "$runs"/rbc_mu0_7.3 --forces 0,38.9,110,194 --view 35,-60 -o "$figs/fig14_rbc_shapes.png"
+$python scripts/plot_shapes.py "$runs/channel" --frames 0,-1 --box --side x --columns 1 -o "$figs/fig15_channel.png"
