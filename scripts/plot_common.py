@@ -31,14 +31,21 @@ def read_config(run_dir):
         return tomllib.load(f)
 
 
-def read_diagnostics(run_dir):
-    """diagnostics.csv as a dict column name -> numpy array (float)."""
-    path = os.path.join(run_dir, "diagnostics.csv")
+def read_table(run_dir, name, what, empty):
+    """DIR/name (a CSV with a header) as a numpy record array; `what` names the run that writes it, `empty` says
+    why it may have no rows."""
+    path = os.path.join(run_dir, name)
     if not os.path.isfile(path):
-        fail(f"{path} not found: is {run_dir} the --out directory of an 'immerse run'?")
+        fail(f"{path} not found: is {run_dir} the --out directory of {what}?")
     data = np.genfromtxt(path, delimiter=",", names=True, ndmin=1)
     if data.size == 0:
-        fail(f"{path} has no rows")
+        fail(f"{path} has no rows{empty}")
+    return path, data
+
+
+def read_diagnostics(run_dir):
+    """diagnostics.csv as a dict column name -> numpy array (float)."""
+    _, data = read_table(run_dir, "diagnostics.csv", "an 'immerse run'", "")
     return {name: np.asarray(data[name], dtype=float) for name in data.dtype.names}
 
 
@@ -100,12 +107,8 @@ def parse_numbers(option, text):
 
 def read_stretch(run_dir):
     """DIR/stretch.csv of an rbc_stretch run as (force_pN, axial_um, transverse_um) numpy arrays."""
-    path = os.path.join(run_dir, "stretch.csv")
-    if not os.path.isfile(path):
-        fail(f"{path} not found: is {run_dir} the --out directory of an rbc_stretch run?")
-    data = np.genfromtxt(path, delimiter=",", names=True, ndmin=1)
-    if data.size == 0:
-        fail(f"{path} has no rows (the sweep stopped before its first force was steady)")
+    path, data = read_table(run_dir, "stretch.csv", "an rbc_stretch run",
+                            " (the sweep stopped before its first force was steady)")
     for name in ("force_pN", "axial_um", "transverse_um"):
         if name not in data.dtype.names:
             fail(f"{path} has no column {name!r}")
