@@ -1,5 +1,7 @@
 #include "immerse/io/XdmfWriter.hpp"
 
+#include <algorithm>
+#include <array>
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
@@ -45,6 +47,7 @@ std::vector<double> flatten(std::span<const Vec3> v) {
   return out;
 }
 
+const char* kSeriesTail = "    </Grid>\n  </Domain>\n</Xdmf>\n";
 const char* kMembraneAttr = "xdmf_membranes";
 const char* kFluidAttr = "xdmf_fluid";
 
@@ -60,7 +63,10 @@ XdmfWriter::XdmfWriter(std::filesystem::path dir, int first_frame) : dir_(std::m
   std::error_code ec;
   std::filesystem::create_directories(dir_, ec);
   if (ec) throw WriteError("cannot write " + dir_.string() + ": " + ec.message());
+  if (first_frame == 0) return;
+  // A restart: the series files are rebuilt from the fragments stored in frames 0..first_frame-1 (one at a time).
   hdf5::Quiet quiet;
+  std::string membranes = series_head("membranes"), fluid = series_head("fluid");
   for (int f = 0; f < first_frame; ++f) {
     const std::filesystem::path p = dir_ / frame_file_name(f);
     hdf5::Handle file = H5Fis_hdf5(p.c_str()) > 0 ? hdf5::open_file_readonly(p) : hdf5::Handle{};
@@ -69,9 +75,12 @@ XdmfWriter::XdmfWriter(std::filesystem::path dir, int first_frame) : dir_(std::m
         !hdf5::read_attribute(file.get(), kFluidAttr, fl))
       throw InputError("cannot continue the output series: " + p.string() +
                        " is missing, truncated or not written by immerse");
-    membrane_xml_.push_back(std::move(m));
-    fluid_xml_.push_back(std::move(fl));
+    membranes += m;
+    fluid += fl;
   }
+  AtomicFile::write(dir_ / "membranes.xdmf", membranes + kSeriesTail);
+  AtomicFile::write(dir_ / "fluid.xdmf", fluid + kSeriesTail);
+  frames_ = first_frame;
 }
 
 std::filesystem::path XdmfWriter::write_frame(double time, std::span<const SurfaceFrame> membranes,
@@ -177,22 +186,60 @@ std::filesystem::path XdmfWriter::write_frame(double time, std::span<const Surfa
   check(file.close(), "the file image");
   AtomicFile::write(path, image);
 
-  membrane_xml_.push_back(std::move(mx));
-  fluid_xml_.push_back(std::move(fx));
-  write_series();
+  append_to_series("membranes", mx);
+  append_to_series("fluid", fx);
+  ++frames_;
   return path;
 }
 
-void XdmfWriter::write_series() const {
-  const auto series = [&](const std::string& name, const std::vector<std::string>& fragments) {
-    std::string x = "<?xml version=\"1.0\" ?>\n<!DOCTYPE Xdmf SYSTEM \"Xdmf.dtd\" []>\n<Xdmf Version=\"3.0\">\n"
-                    "  <Domain>\n    <Grid Name=\"" + name + "\" GridType=\"Collection\" CollectionType=\"Temporal\">\n";
-    for (const auto& f : fragments) x += f;
-    x += "    </Grid>\n  </Domain>\n</Xdmf>\n";
-    AtomicFile::write(dir_ / (name + ".xdmf"), x);
+std::string XdmfWriter::series_head(const std::string& name) {
+  return "<?xml version=\"1.0\" ?>\n<!DOCTYPE Xdmf SYSTEM \"Xdmf.dtd\" []>\n<Xdmf Version=\"3.0\">\n"
+         "  <Domain>\n    <Grid Name=\"" + name + "\" GridType=\"Collection\" CollectionType=\"Temporal\">\n";
+}
+
+// The new series file is the old one without its closing tail, then the fragment and the tail, copied through a
+// fixed buffer: the writer's memory does not grow with the number of frames.
+void XdmfWriter::append_to_series(const std::string& name, const std::string& fragment) const {
+  const std::filesystem::path path = dir_ / (name + ".xdmf");
+  AtomicFile out(path);
+  std::FILE* to = std::fopen(out.temp_path().c_str(), "wb");
+  if (!to) out.fail(errno);
+  const auto put = [&](const char* data, std::size_t n) {
+    if (std::fwrite(data, 1, n, to) != n) {
+      const int err = errno;
+      std::fclose(to);
+      out.fail(err);
+    }
   };
-  series("membranes", membrane_xml_);
-  series("fluid", fluid_xml_);
+  if (frames_ == 0) {
+    const std::string head = series_head(name);
+    put(head.data(), head.size());
+  } else {
+    std::error_code ec;
+    const auto size = std::filesystem::file_size(path, ec);
+    std::FILE* from = ec ? nullptr : std::fopen(path.c_str(), "rb");
+    if (!from || size < std::strlen(kSeriesTail)) {
+      if (from) std::fclose(from);
+      std::fclose(to);
+      out.fail("the series file " + path.string() + " is missing or damaged");
+    }
+    std::array<char, 65536> buf;
+    for (auto left = size - std::strlen(kSeriesTail); left > 0;) {
+      const std::size_t n = std::fread(buf.data(), 1, std::min<std::uintmax_t>(left, buf.size()), from);
+      if (n == 0) {
+        std::fclose(from);
+        std::fclose(to);
+        out.fail("cannot read the series file " + path.string());
+      }
+      put(buf.data(), n);
+      left -= n;
+    }
+    std::fclose(from);
+  }
+  put(fragment.data(), fragment.size());
+  put(kSeriesTail, std::strlen(kSeriesTail));
+  if (std::fclose(to) != 0) out.fail(errno);
+  out.commit();
 }
 
 }  // namespace immerse::io

@@ -9,6 +9,8 @@
 // HDF5 layout of a frame: attribute "time"; /membranes/<name>/{nodes [N,3], connectivity [T,6] int32,
 // <field> [N,3] or [N]}; /fluid/{velocity [nz,ny,nx,3], pressure [nz,ny,nx], vorticity_magnitude [nz,ny,nx]}.
 // Each frame file also stores its own XDMF fragments (attributes), so a restarted run can rebuild the series.
+// Each frame appends its fragments to the series files (rewritten atomically through a fixed buffer), so the
+// writer's memory does not grow with the number of frames.
 #include <array>
 #include <filesystem>
 #include <span>
@@ -51,16 +53,16 @@ class XdmfWriter {
   std::filesystem::path write_frame(double time, std::span<const SurfaceFrame> membranes,
                                     const FluidFrame* fluid = nullptr);
 
-  int frames() const { return static_cast<int>(membrane_xml_.size()); }
+  int frames() const { return frames_; }
   const std::filesystem::path& dir() const { return dir_; }
   static std::string frame_file_name(int frame);
 
  private:
-  void write_series() const;
+  static std::string series_head(const std::string& name);
+  void append_to_series(const std::string& name, const std::string& fragment) const;
 
   std::filesystem::path dir_;
-  std::vector<std::string> membrane_xml_;  // per frame: a <Grid> fragment of membranes.xdmf
-  std::vector<std::string> fluid_xml_;     // per frame: a <Grid> fragment of fluid.xdmf, or "" without fluid
+  int frames_ = 0;
 };
 
 }  // namespace immerse::io
