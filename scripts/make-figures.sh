@@ -5,7 +5,10 @@
 #   oscillating_membrane_quick at mu = 0.01 and 0.1                        (§4.1,   Figs. 2-5)
 #   capsule_shear_quick at G = 0.0125, 0.05 and 0.1                       (§4.2.1, Fig. 7)
 #   oblate_shear_quick at b/a = 0.9 (G = 0.1, 0.2) and b/a = 0.5 (G = 0.2, level 3)  (§4.2.2, Figs. 8-9)
+#   oscillating_membrane_quick with explicit Euler and with JFNK at dt = 4 dx, a frame per step     (§4.1, Fig. 6)
 #   bending_shear_quick at G = 0.05, kappa_B_hat = 0, 0.01, 0.025, 0.0375 to k t = 4   (§4.2.3, Fig. 11a)
+#   bending_shear_quick at G = 0.2, kappa_B_hat = 0, 0.04, 0.1, 0.15 to k t = 4       (§4.2.3, Fig. 11b)
+#   rbc_channel_quick, 32 cells to t = 0.05 s                                         (§4.4, Fig. 15)
 #   rbc_stretch_quick at mu0 = 7.3, 10 uN/m, forces 0, 38.9, 110, 194 pN, looser steady state  (§4.3, Figs. 13-14)
 # into out/figures/, then plots with Debian's matplotlib (/usr/bin/python3). Each plot script prints its key numbers.
 set -euo pipefail
@@ -44,6 +47,11 @@ start() { # start SCENARIO OUTDIR [...]: run in the background, at most $jobs_ma
 
 start oscillating_membrane_quick "$runs/osc_mu0.01" --set fluid.mu=0.01
 start oscillating_membrane_quick "$runs/osc_mu0.1" --set fluid.mu=0.1
+# Fig. 6: explicit Euler and JFNK at dt = 4 dx, a frame every step; Euler goes unstable within about ten steps.
+MAY_STOP=1 start oscillating_membrane_quick "$runs/osc_euler" --set fluid.mu=0.01 --set time.scheme=euler \
+  --set time.end=1.5 --set output.fields_every=1 --set output.fluid_fields=false
+start oscillating_membrane_quick "$runs/osc_jfnk" --set fluid.mu=0.01 --set time.end=1.5 --set output.fields_every=1 \
+  --set output.fluid_fields=false
 for G in 0.0125 0.05 0.1; do
   start capsule_shear_quick "$runs/shear_G$G" --set scenario.G=$G
 done
@@ -68,6 +76,11 @@ for mu0 in 7.3 10; do
     --set "scenario.forces_pN=[0, 38.9, 110, 194]" --set scenario.steady_tol=5e-3 \
     --set scenario.max_relaxation_times=8 "${frames[@]}"
 done
+# Fig. 11b: G = 0.2 with kappa_B_hat = 0, 0.04, 0.1, 0.15.
+for kappa in 0 0.04 0.1 0.15; do
+  start bending_shear_quick "$runs/bending_G0.2_kB$kappa" --set scenario.G=0.2 --set scenario.kappa_B_hat=$kappa \
+    --set scenario.kt_end=4
+done
 # Fig. 15: the 32 cells of the quick channel at t = 0 and t = 0.05 s (the longest of these runs).
 start rbc_channel_quick "$runs/channel" --set output.fluid_fields=false
 wait
@@ -81,6 +94,9 @@ $python scripts/plot_taylor.py "$runs"/shear_G0.0125 "$runs"/shear_G0.05 "$runs"
 $python scripts/plot_taylor.py "$runs"/oblate_ba0.9_G0.1 "$runs"/oblate_ba0.9_G0.2 -o "$figs/fig8_oblate_ba0.9.png"
 $python scripts/plot_taylor.py "$runs"/oblate_ba0.5_G0.2 -o "$figs/fig9_oblate_ba0.5.png"
 $python scripts/plot_taylor.py "$runs"/bending_G0.05_kB{0,0.01,0.025,0.0375} -o "$figs/fig11_bending_G0.05.png"
+$python scripts/plot_taylor.py "$runs"/bending_G0.2_kB{0,0.04,0.1,0.15} -o "$figs/fig11b_bending_G0.2.png"
+$python scripts/plot_shapes.py "$runs/osc_euler" --frames 0,3,6,-1 -o "$figs/fig6_explicit_shapes.png"
+$python scripts/plot_shapes.py "$runs/osc_jfnk" --frames 0,3,6,-1 -o "$figs/fig6_implicit_shapes.png"
 $python scripts/plot_stretch.py "$runs"/rbc_mu0_7.3 "$runs"/rbc_mu0_10 -o "$figs/fig13_stretch.png"
 $python scripts/plot_shapes.py "$runs"/rbc_mu0_7.3 --forces 0,38.9,110,194 --view 35,-60 -o "$figs/fig14_rbc_shapes.png"
 $python scripts/plot_shapes.py "$runs/channel" --frames 0,-1 --box --side x --columns 1 -o "$figs/fig15_channel.png"
