@@ -8,8 +8,9 @@
 //     so the bisection can only overestimate the stable step, in the explicit scheme's favour), then its wall time per step over
 //     `explicit_steps` steps, scaled to the end time (the full explicit run would take hours; said in the output);
 //   - the ratio explicit / implicit of the wall times to the end time, and the peak resident memory.
-// Usage: bench_channel [--quick] [--jfnk-steps N]   (--quick: rbc_channel_quick.toml; --jfnk-steps: time N steps
-// of JFNK and scale to the end time instead of running it all)
+// Usage: bench_channel [--quick] [--jfnk-steps N] [--set key=value ...]   (--quick: rbc_channel_quick.toml;
+// --jfnk-steps: time N steps of JFNK and scale to the end time instead of running it all; --set: as for immerse
+// run, e.g. --set scenario.mu0=1e-3 for stiffer cells)
 #include <sys/resource.h>
 
 #include <chrono>
@@ -36,9 +37,11 @@ struct Cost {
   double per_step() const { return seconds / double(steps); }
 };
 
+std::vector<std::string> g_sets;  // the command line's --set overrides
+
 io::Config channel_config(const std::string& file, const std::string& scheme, double dt, double max_speed = 0.1) {
-  std::vector<std::string> sets{"time.scheme=" + scheme, "output.fields_every=0",
-                                "time.max_speed=" + std::to_string(max_speed)};
+  std::vector<std::string> sets = g_sets;
+  sets.insert(sets.end(), {"time.scheme=" + scheme, "output.fields_every=0", "time.max_speed=" + std::to_string(max_speed)});
   if (dt > 0) {
     char buf[64];
     std::snprintf(buf, sizeof buf, "time.dt=%.17g", dt);
@@ -80,26 +83,40 @@ double peak_rss_mib() {
 
 }  // namespace
 
+// The whole benchmark for one scenario file (throws InputError on a bad --set).
+int measure(const std::string& file, long jfnk_steps, bool quick);
+
 int main(int argc, char** argv) {
   bool quick = false;
   long jfnk_steps = 0;
   for (int i = 1; i < argc; ++i) {
     if (std::strcmp(argv[i], "--quick") == 0) quick = true;
     else if (std::strcmp(argv[i], "--jfnk-steps") == 0 && i + 1 < argc) jfnk_steps = std::stol(argv[++i]);
+    else if (std::strcmp(argv[i], "--set") == 0 && i + 1 < argc) g_sets.emplace_back(argv[++i]);
     else {
-      std::fprintf(stderr, "usage: bench_channel [--quick] [--jfnk-steps N]\n");
+      std::fprintf(stderr, "usage: bench_channel [--quick] [--jfnk-steps N] [--set key=value ...]\n");
       return 2;
     }
   }
   const std::string file =
       std::string(IMMERSE_SOURCE_DIR) + (quick ? "/scenarios/rbc_channel_quick.toml" : "/scenarios/rbc_channel.toml");
   PetscSession petsc;
+  try {
+    return measure(file, jfnk_steps, quick);
+  } catch (const InputError& e) {
+    std::fprintf(stderr, "bench_channel: %s\n", e.what());
+    return 2;
+  }
+}
+
+int measure(const std::string& file, long jfnk_steps, bool quick) {
   const io::Config base = channel_config(file, "jfnk", 0);
   const double dt = base.get<double>("time.dt"), T = base.get<double>("time.end");
-  std::printf("§4.4 rbc_channel (%s): %lld x %lld x %lld grid, 32 cells of %s level %lld, dt = %g s, t_end = %g s\n",
+  std::printf("§4.4 rbc_channel (%s): %lld x %lld x %lld grid, 32 cells of %s level %lld, mu0 = %g N/m, dt = %g s, "
+              "t_end = %g s\n",
               file.c_str(), (long long)base.get<int>("grid.nx"), (long long)base.get<int>("grid.ny"),
               (long long)base.get<int>("grid.nz"), base.get<std::string>("membrane[0].mesh.family").c_str(),
-              (long long)base.get<int>("membrane[0].mesh.level"), dt, T);
+              (long long)base.get<int>("membrane[0].mesh.level"), base.get<double>("scenario.mu0"), dt, T);
 
   const Cost j = run(base, jfnk_steps);
   const double t_jfnk = j.per_step() * T / dt;
