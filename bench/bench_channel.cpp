@@ -106,6 +106,9 @@ int main(int argc, char** argv) {
   } catch (const InputError& e) {
     std::fprintf(stderr, "bench_channel: %s\n", e.what());
     return 2;
+  } catch (const SimulationError& e) {
+    std::fprintf(stderr, "bench_channel: the JFNK run stopped: %s\n", e.what());
+    return 3;
   }
 }
 
