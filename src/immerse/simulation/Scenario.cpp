@@ -86,8 +86,7 @@ io::Config derive(const io::Config& config) {
       const Vec3& p = centres[i];
       set.push_back(prefix + "center=[" + num(p.x) + "," + num(p.y) + "," + num(p.z) + "]");
     }
-    config.schema().apply_overrides(derived, set);
-    return derived;
+    return with_derived(derived, set, kind, "membrane[0] and the domain");
   }
   if (!is_shear(kind)) return config;
   if (config.count("membrane") != 1) throw InputError("scenario.kind = \"" + kind + "\": needs exactly one [[membrane]]");
