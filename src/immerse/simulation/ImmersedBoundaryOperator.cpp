@@ -1,6 +1,9 @@
 #include "immerse/simulation/ImmersedBoundaryOperator.hpp"
 
+#include <omp.h>
+
 #include <algorithm>
+#include <exception>
 #include <cmath>
 #include <limits>
 #include <string>
@@ -18,7 +21,8 @@ ImmersedBoundaryOperator::ImmersedBoundaryOperator(NavierStokesSolver& fluid, IB
       membranes_(std::move(membranes)),
       committed_(std::move(fluid_state)),
       force_start_(fluid.grid()),
-      force_(fluid.grid()) {
+      force_(fluid.grid()),
+      mixed_(fluid.grid()) {
   if (X0.size() != membranes_.size()) throw std::logic_error("ImmersedBoundaryOperator: one position array per membrane");
   for (std::size_t m = 0; m < membranes_.size(); ++m) {
     if (X0[m].size() != membranes_[m]->num_nodes())
@@ -37,33 +41,53 @@ ImmersedBoundaryOperator::ImmersedBoundaryOperator(NavierStokesSolver& fluid, IB
   coupler_.interpolate_velocity(committed_.u, X_, U_);
 }
 
-void ImmersedBoundaryOperator::membrane_force_density(std::span<const Vec3> X, FaceField& f) {
-  for (std::size_t m = 0; m < membranes_.size(); ++m) {
-    std::copy(X.begin() + static_cast<std::ptrdiff_t>(offset_[m]), X.begin() + static_cast<std::ptrdiff_t>(offset_[m + 1]),
-              Xm_[m].begin());
-    try {
-      check_nodes_in_domain(fluid_.grid(), Xm_[m]);
-      membranes_[m]->compute_force(Xm_[m], Fm_[m]);
-    } catch (const SimulationError& e) {
-      throw SimulationError("membrane[" + std::to_string(m) + "] " + e.what());
-    }
-    for (std::size_t i = 0; i < Fm_[m].size(); ++i) F_[offset_[m] + i] = Fm_[m][i] + applied_[offset_[m] + i];
+void ImmersedBoundaryOperator::nodal_force(std::size_t m, std::span<const Vec3> X) {
+  std::copy(X.begin() + static_cast<std::ptrdiff_t>(offset_[m]), X.begin() + static_cast<std::ptrdiff_t>(offset_[m + 1]),
+            Xm_[m].begin());
+  try {
+    check_nodes_in_domain(fluid_.grid(), Xm_[m]);
+    membranes_[m]->compute_force(Xm_[m], Fm_[m]);
+  } catch (const SimulationError& e) {
+    throw SimulationError("membrane[" + std::to_string(m) + "] " + e.what());
   }
+  for (std::size_t i = 0; i < Fm_[m].size(); ++i) F_[offset_[m] + i] = Fm_[m][i] + applied_[offset_[m] + i];
+}
+
+// With many membranes each thread takes whole membranes (each evaluated without inner parallelism: no barrier
+// per pass); with few, one membrane at a time with OpenMP inside ElasticMembrane. A membrane's forces do not
+// depend on the thread count either way, and the error reported is that of the lowest-numbered failing membrane.
+void ImmersedBoundaryOperator::membrane_force_density(std::span<const Vec3> X, FaceField& f) {
+  const int M = static_cast<int>(membranes_.size());
+  const bool across = M >= 2 * omp_get_max_threads();
+  std::vector<std::exception_ptr> error(membranes_.size());
+#pragma omp parallel for schedule(dynamic) if (across)
+  for (int m = 0; m < M; ++m) {
+    try {
+      nodal_force(static_cast<std::size_t>(m), X);
+    } catch (...) {
+      error[m] = std::current_exception();
+    }
+  }
+  for (const auto& e : error)
+    if (e) std::rethrow_exception(e);
   coupler_.spread_force(X, F_, f);
 }
 
 void ImmersedBoundaryOperator::trial_velocity(std::span<const double> Xf, double theta, std::span<const double> Xi,
                                               double dt, std::span<double> U) {
+  trial_X_.clear();
   membrane_force_density(nodes(Xf), force_);
+  trial_X_.assign(Xf.begin(), Xf.end());
   if (theta < 1.0) {
     for (int d = 0; d < 3; ++d) {
-      auto& a = force_[d];
-      const auto& b = force_start_[d];
+      auto& a = mixed_[d];
+      const auto& b = force_[d];
+      const auto& c = force_start_[d];
 #pragma omp parallel for
-      for (std::size_t i = 0; i < a.size(); ++i) a[i] = theta * a[i] + (1.0 - theta) * b[i];
+      for (std::size_t i = 0; i < a.size(); ++i) a[i] = theta * b[i] + (1.0 - theta) * c[i];
     }
   }
-  fluid_.step(committed_, force_, dt, trial_);
+  fluid_.step(committed_, theta < 1.0 ? mixed_ : force_, dt, trial_);
   ++solves_;
   coupler_.interpolate_velocity(trial_.u, nodes(Xi), {reinterpret_cast<Vec3*>(U.data()), U.size() / 3});
 }
@@ -77,7 +101,12 @@ void ImmersedBoundaryOperator::commit(std::span<const double> X, double) {
   const auto Xn = nodes(X);
   std::copy(Xn.begin(), Xn.end(), X_.begin());
   coupler_.interpolate_velocity(committed_.u, X_, U_);
-  membrane_force_density(X_, force_start_);
+  // An implicit step's last trial was driven by X^{n+1} itself: its S(X^{n+1}) f(X^{n+1}) is the next step's start.
+  if (std::ranges::equal(X, trial_X_))
+    std::swap(force_start_, force_);
+  else
+    membrane_force_density(X_, force_start_);
+  trial_X_.clear();
 }
 
 std::vector<Vec3> ImmersedBoundaryOperator::membrane_positions(std::size_t m) const {
@@ -91,6 +120,7 @@ std::vector<Vec3> ImmersedBoundaryOperator::membrane_velocities(std::size_t m) c
 void ImmersedBoundaryOperator::set_applied_forces(std::size_t m, const std::vector<Vec3>& F) {
   if (F.size() != offset_[m + 1] - offset_[m]) throw std::logic_error("set_applied_forces: one force per node");
   std::copy(F.begin(), F.end(), applied_.begin() + static_cast<std::ptrdiff_t>(offset_[m]));
+  trial_X_.clear();
   membrane_force_density(X_, force_start_);
 }
 

@@ -7,7 +7,8 @@
 //   J(X) u    interpolated back to the nodes          IBCoupler::interpolate_velocity  (eq. 14)
 //
 // with F^{n+1/2} = (1 - theta) S(X^n) f(X^n) + theta S(Xf) f(Xf); S(X^n) f(X^n) is computed once per step (at
-// commit). The committed fluid state is never modified by trial steps; commit() swaps the last trial in.
+// commit, or taken over from the last trial when that was driven by X^{n+1}, as an implicit step's is). The
+// committed fluid state is never modified by trial steps; commit() swaps the last trial in.
 // All membranes' nodes are concatenated in one array; errors name the membrane and its local node or element.
 #include <vector>
 
@@ -54,6 +55,8 @@ class ImmersedBoundaryOperator final : public CoupledOperator {
   static std::span<const Vec3> nodes(std::span<const double> x) {
     return {reinterpret_cast<const Vec3*>(x.data()), x.size() / 3};
   }
+  /// F_ for membrane m at the all-membrane positions X: its elastic force plus the applied force.
+  void nodal_force(std::size_t m, std::span<const Vec3> X);
   /// f = S(X) f(X) for all membranes.
   void membrane_force_density(std::span<const Vec3> X, FaceField& f);
 
@@ -63,8 +66,10 @@ class ImmersedBoundaryOperator final : public CoupledOperator {
   std::vector<std::size_t> offset_;  ///< first node of membrane m in the concatenated arrays
   std::vector<Vec3> X_, U_;          ///< committed positions and node velocities
   FluidState committed_, trial_;
-  FaceField force_start_;  ///< S(X^n) f(X^n)
-  FaceField force_;
+  FaceField force_start_;       ///< S(X^n) f(X^n)
+  FaceField force_;             ///< S(Xf) f(Xf) of the last trial
+  FaceField mixed_;             ///< F^{n+1/2} of the last trial (theta < 1)
+  std::vector<double> trial_X_;  ///< the Xf of the last trial (empty when it cannot be reused at commit)
   std::vector<Vec3> F_;                                 ///< nodal forces, all membranes
   std::vector<Vec3> applied_;                           ///< external nodal forces, all membranes
   std::vector<std::vector<Vec3>> Xm_, Fm_;              ///< per-membrane scratch for compute_force

@@ -132,10 +132,20 @@ StepStats SnesIntegrator::step(CoupledOperator& op, double dt) {
   IMMERSE_PETSC(VecGetArray(x_, &xs));
   {
     std::vector<double> X0(n_);
-    residual.initial_guess(previous_positions(), previous_dt(), X0);
+    residual.initial_guess(previous_velocity(), previous_dt(), X0);
     for (std::size_t i = 0; i < n_; ++i) xs[i] = X0[i] / scale_;
   }
   IMMERSE_PETSC(VecRestoreArray(x_, &xs));
+  PetscBool user_atol = PETSC_FALSE;
+  IMMERSE_PETSC(PetscOptionsHasName(options_, nullptr, "-ksp_atol", &user_atol));
+  if (method_ == Method::NewtonKrylov && !user_atol) {  // GMRES's absolute stop: half the Newton tolerance
+    PetscReal xnorm;
+    KSP ksp;
+    IMMERSE_PETSC(VecNorm(x_, NORM_2, &xnorm));
+    IMMERSE_PETSC(SNESGetKSP(snes_, &ksp));
+    IMMERSE_PETSC(KSPSetTolerances(ksp, PETSC_DEFAULT, 0.5 * settings_.newton_rtol * xnorm, PETSC_DEFAULT,
+                                   PETSC_DEFAULT));
+  }
 
   const PetscErrorCode ierr = SNESSolve(snes_, nullptr, x_);
   residual_ = nullptr;
