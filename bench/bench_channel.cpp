@@ -7,10 +7,14 @@
 //     faster than 4 mm/s, 11 times the empty duct's centre velocity; a slowly growing instability can pass the test,
 //     so the bisection can only overestimate the stable step, in the explicit scheme's favour), then its wall time per step over
 //     `explicit_steps` steps, scaled to the end time (the full explicit run would take hours; said in the output);
-//   - the ratio explicit / implicit of the wall times to the end time, and the peak resident memory.
-// Usage: bench_channel [--quick] [--jfnk-steps N] [--set key=value ...]   (--quick: rbc_channel_quick.toml;
-// --jfnk-steps: time N steps of JFNK and scale to the end time instead of running it all; --set: as for immerse
-// run, e.g. --set scenario.mu0=1e-3 for stiffer cells)
+//   - the ratio explicit / implicit of the wall times to the end time, and the peak resident memory;
+//   - for each scheme, where the time goes: membrane forces, spreading, fluid, interpolation, the rest (the
+//     nonlinear solver's vector work, stability checks), from the operator's timers (StepTimings).
+// Usage: bench_channel [--quick] [--jfnk-steps N] [--jfnk-only] [--set key=value ...]
+//   --quick         rbc_channel_quick.toml (48 x 96 x 24, 642 nodes per cell) instead of rbc_channel.toml
+//   --jfnk-steps N  time N steps of JFNK and scale to the end time instead of running it all
+//   --jfnk-only     skip the explicit scheme
+//   --set k=v       as for immerse run, e.g. --set scenario.mu0=1e-3 for stiffer cells
 #include <sys/resource.h>
 
 #include <chrono>
@@ -34,7 +38,17 @@ namespace {
 struct Cost {
   long steps = 0;
   double seconds = 0, solves = 0, newton = 0, gmres = 0;
+  StepTimings parts;
   double per_step() const { return seconds / double(steps); }
+  // Where the time went, per step: membrane forces, spreading, fluid, interpolation, the rest.
+  void print_profile(const char* scheme) const {
+    const double n = double(steps), rest = seconds - parts.force - parts.spread - parts.fluid - parts.interpolate;
+    std::printf("%s profile, ms per step (%% of the step): membrane forces %.0f (%.0f %%), spreading %.0f (%.0f %%), "
+                "fluid %.0f (%.0f %%), interpolation %.0f (%.0f %%), the rest %.0f (%.0f %%)\n",
+                scheme, 1e3 * parts.force / n, 100 * parts.force / seconds, 1e3 * parts.spread / n,
+                100 * parts.spread / seconds, 1e3 * parts.fluid / n, 100 * parts.fluid / seconds,
+                1e3 * parts.interpolate / n, 100 * parts.interpolate / seconds, 1e3 * rest / n, 100 * rest / seconds);
+  }
 };
 
 std::vector<std::string> g_sets;  // the command line's --set overrides
@@ -63,6 +77,7 @@ Cost run(const io::Config& config, long steps) {
     c.gmres += double(r.stats.gmres_its);
   }
   c.seconds = std::chrono::duration<double>(Clock::now() - t0).count();
+  c.parts = sim.op().timings();
   return c;
 }
 
@@ -84,17 +99,18 @@ double peak_rss_mib() {
 }  // namespace
 
 // The whole benchmark for one scenario file (throws InputError on a bad --set).
-int measure(const std::string& file, long jfnk_steps, bool quick);
+int measure(const std::string& file, long jfnk_steps, bool quick, bool jfnk_only);
 
 int main(int argc, char** argv) {
-  bool quick = false;
+  bool quick = false, jfnk_only = false;
   long jfnk_steps = 0;
   for (int i = 1; i < argc; ++i) {
     if (std::strcmp(argv[i], "--quick") == 0) quick = true;
+    else if (std::strcmp(argv[i], "--jfnk-only") == 0) jfnk_only = true;
     else if (std::strcmp(argv[i], "--jfnk-steps") == 0 && i + 1 < argc) jfnk_steps = std::stol(argv[++i]);
     else if (std::strcmp(argv[i], "--set") == 0 && i + 1 < argc) g_sets.emplace_back(argv[++i]);
     else {
-      std::fprintf(stderr, "usage: bench_channel [--quick] [--jfnk-steps N] [--set key=value ...]\n");
+      std::fprintf(stderr, "usage: bench_channel [--quick] [--jfnk-steps N] [--jfnk-only] [--set key=value ...]\n");
       return 2;
     }
   }
@@ -102,7 +118,7 @@ int main(int argc, char** argv) {
       std::string(IMMERSE_SOURCE_DIR) + (quick ? "/scenarios/rbc_channel_quick.toml" : "/scenarios/rbc_channel.toml");
   PetscSession petsc;
   try {
-    return measure(file, jfnk_steps, quick);
+    return measure(file, jfnk_steps, quick, jfnk_only);
   } catch (const InputError& e) {
     std::fprintf(stderr, "bench_channel: %s\n", e.what());
     return 2;
@@ -112,7 +128,7 @@ int main(int argc, char** argv) {
   }
 }
 
-int measure(const std::string& file, long jfnk_steps, bool quick) {
+int measure(const std::string& file, long jfnk_steps, bool quick, bool jfnk_only) {
   const io::Config base = channel_config(file, "jfnk", 0);
   const double dt = base.get<double>("time.dt"), T = base.get<double>("time.end");
   std::printf("§4.4 rbc_channel (%s): %lld x %lld x %lld grid, 32 cells of %s level %lld, mu0 = %g N/m, dt = %g s, "
@@ -126,7 +142,12 @@ int measure(const std::string& file, long jfnk_steps, bool quick) {
   std::printf("JFNK: %ld steps in %.1f s (%.3f s/step), per step %.2f fluid solves, %.2f Newton, %.2f GMRES%s\n",
               j.steps, j.seconds, j.per_step(), j.solves / double(j.steps), j.newton / double(j.steps),
               j.gmres / double(j.steps), jfnk_steps > 0 ? " (scaled to t_end below)" : "");
+  j.print_profile("JFNK");
   std::fflush(stdout);
+  if (jfnk_only) {
+    std::printf("peak resident memory: %.0f MiB\n", peak_rss_mib());
+    return 0;
+  }
 
   // Largest stable RK2 step: bracket [lo stable, hi unstable], then bisect on log(dt).
   const long probe = quick ? 100 : 60;
@@ -145,6 +166,7 @@ int measure(const std::string& file, long jfnk_steps, bool quick) {
   std::printf("RK2: largest stable dt = %.4g s (paper: 1.875e-6; %ld-step blow-up test), %.3f s/step, %.2f fluid "
               "solves/step; %.0f steps to t_end\n",
               lo, probe, e.per_step(), e.solves / double(e.steps), T / lo);
+  e.print_profile("RK2");
   std::printf("wall time to t = %g s: JFNK %.1f s%s, explicit RK2 %.1f s (from %ld timed steps, scaled)\n", T, t_jfnk,
               jfnk_steps > 0 ? " (scaled)" : "", t_explicit, explicit_steps);
   std::printf("ratio explicit / implicit: %.1f (paper: 43)\n", t_explicit / t_jfnk);

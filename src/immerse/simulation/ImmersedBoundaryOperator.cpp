@@ -3,6 +3,7 @@
 #include <omp.h>
 
 #include <algorithm>
+#include <chrono>
 #include <exception>
 #include <cmath>
 #include <limits>
@@ -12,6 +13,18 @@
 #include "immerse/coupling/NodeDiagnostics.hpp"
 
 namespace immerse {
+
+namespace {
+
+/// Runs f and adds its wall time to `seconds`.
+template <class F>
+void timed(double& seconds, F&& f) {
+  const auto t0 = std::chrono::steady_clock::now();
+  f();
+  seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+}  // namespace
 
 ImmersedBoundaryOperator::ImmersedBoundaryOperator(NavierStokesSolver& fluid, IBCoupler& coupler,
                                                    std::vector<const ElasticMembrane*> membranes,
@@ -60,17 +73,19 @@ void ImmersedBoundaryOperator::membrane_force_density(std::span<const Vec3> X, F
   const int M = static_cast<int>(membranes_.size());
   const bool across = M >= 2 * omp_get_max_threads();
   std::vector<std::exception_ptr> error(membranes_.size());
+  timed(timings_.force, [&] {
 #pragma omp parallel for schedule(dynamic) if (across)
-  for (int m = 0; m < M; ++m) {
-    try {
-      nodal_force(static_cast<std::size_t>(m), X);
-    } catch (...) {
-      error[m] = std::current_exception();
+    for (int m = 0; m < M; ++m) {
+      try {
+        nodal_force(static_cast<std::size_t>(m), X);
+      } catch (...) {
+        error[m] = std::current_exception();
+      }
     }
-  }
+  });
   for (const auto& e : error)
     if (e) std::rethrow_exception(e);
-  coupler_.spread_force(X, F_, f);
+  timed(timings_.spread, [&] { coupler_.spread_force(X, F_, f); });
 }
 
 void ImmersedBoundaryOperator::trial_velocity(std::span<const double> Xf, double theta, std::span<const double> Xi,
@@ -78,29 +93,35 @@ void ImmersedBoundaryOperator::trial_velocity(std::span<const double> Xf, double
   trial_X_.clear();
   membrane_force_density(nodes(Xf), force_);
   trial_X_.assign(Xf.begin(), Xf.end());
-  if (theta < 1.0) {
-    for (int d = 0; d < 3; ++d) {
-      auto& a = mixed_[d];
-      const auto& b = force_[d];
-      const auto& c = force_start_[d];
+  timed(timings_.fluid, [&] {
+    if (theta < 1.0) {
+      for (int d = 0; d < 3; ++d) {
+        auto& a = mixed_[d];
+        const auto& b = force_[d];
+        const auto& c = force_start_[d];
 #pragma omp parallel for
-      for (std::size_t i = 0; i < a.size(); ++i) a[i] = theta * b[i] + (1.0 - theta) * c[i];
+        for (std::size_t i = 0; i < a.size(); ++i) a[i] = theta * b[i] + (1.0 - theta) * c[i];
+      }
     }
-  }
-  fluid_.step(committed_, theta < 1.0 ? mixed_ : force_, dt, trial_);
+    fluid_.step(committed_, theta < 1.0 ? mixed_ : force_, dt, trial_);
+  });
   ++solves_;
-  coupler_.interpolate_velocity(trial_.u, nodes(Xi), {reinterpret_cast<Vec3*>(U.data()), U.size() / 3});
+  timed(timings_.interpolate, [&] {
+    coupler_.interpolate_velocity(trial_.u, nodes(Xi), {reinterpret_cast<Vec3*>(U.data()), U.size() / 3});
+  });
 }
 
 void ImmersedBoundaryOperator::committed_velocity(std::span<const double> Xi, std::span<double> U) {
-  coupler_.interpolate_velocity(committed_.u, nodes(Xi), {reinterpret_cast<Vec3*>(U.data()), U.size() / 3});
+  timed(timings_.interpolate, [&] {
+    coupler_.interpolate_velocity(committed_.u, nodes(Xi), {reinterpret_cast<Vec3*>(U.data()), U.size() / 3});
+  });
 }
 
 void ImmersedBoundaryOperator::commit(std::span<const double> X, double) {
   std::swap(committed_, trial_);
   const auto Xn = nodes(X);
   std::copy(Xn.begin(), Xn.end(), X_.begin());
-  coupler_.interpolate_velocity(committed_.u, X_, U_);
+  timed(timings_.interpolate, [&] { coupler_.interpolate_velocity(committed_.u, X_, U_); });
   // An implicit step's last trial was driven by X^{n+1} itself: its S(X^{n+1}) f(X^{n+1}) is the next step's start.
   if (std::ranges::equal(X, trial_X_))
     std::swap(force_start_, force_);

@@ -19,6 +19,14 @@
 
 namespace immerse {
 
+/// Wall time (seconds) spent so far in each part of the coupled step: the profile of a run by component.
+struct StepTimings {
+  double force = 0;        ///< membrane forces f(X) of all membranes (§2.3)
+  double spread = 0;       ///< S(X) f (eq. 6)
+  double fluid = 0;        ///< the fluid step (eqs. 9-13) with its force F^{n+1/2}
+  double interpolate = 0;  ///< J(X) u (eq. 14)
+};
+
 class ImmersedBoundaryOperator final : public CoupledOperator {
  public:
   /// `membranes` and their initial positions X0 (one array per membrane); the fluid starts from `fluid_state`.
@@ -37,6 +45,7 @@ class ImmersedBoundaryOperator final : public CoupledOperator {
   std::size_t fluid_solves() const override { return solves_; }
 
   const FluidState& fluid_state() const { return committed_; }
+  const StepTimings& timings() const { return timings_; }
   std::size_t num_membranes() const { return membranes_.size(); }
   /// Committed positions of membrane m.
   std::vector<Vec3> membrane_positions(std::size_t m) const;
@@ -74,6 +83,7 @@ class ImmersedBoundaryOperator final : public CoupledOperator {
   std::vector<Vec3> applied_;                           ///< external nodal forces, all membranes
   std::vector<std::vector<Vec3>> Xm_, Fm_;              ///< per-membrane scratch for compute_force
   std::size_t solves_ = 0;
+  StepTimings timings_;
 };
 
 static_assert(sizeof(Vec3) == 3 * sizeof(double), "positions are viewed as flat arrays of doubles");

@@ -193,6 +193,24 @@ class Progress {
   clock::time_point t0_, last_;
 };
 
+// Where the stepping time went, by component of the coupled step (the rest: the nonlinear solver's vector work,
+// the stability and clearance checks).
+std::string step_profile(const StepTimings& t, double stepping) {
+  const std::pair<const char*, double> parts[] = {{"membrane forces", t.force},
+                                                  {"spreading", t.spread},
+                                                  {"fluid", t.fluid},
+                                                  {"interpolation", t.interpolate}};
+  std::ostringstream s;
+  s << std::fixed << std::setprecision(1) << "stepping took " << stepping << " s: ";
+  double rest = stepping;
+  for (const auto& [name, seconds] : parts) {
+    s << name << " " << 100 * seconds / stepping << " %, ";
+    rest -= seconds;
+  }
+  s << "the rest " << 100 * rest / stepping << " %";
+  return s.str();
+}
+
 std::string grid_text(const io::Config& c) {
   return "grid " + std::to_string(c.get<int>("grid.nx")) + " x " + std::to_string(c.get<int>("grid.ny")) + " x " +
          std::to_string(c.get<int>("grid.nz"));
@@ -311,6 +329,7 @@ int run_command(const RunOptions& options, std::ostream& out, std::ostream& err)
   auto log = [&](const std::string& msg) { out << "\n" << msg << "\n"; };
   int status = 0;
   long done = 0;
+  double stepping = 0;  // wall time inside Simulation::advance
   // rbc_stretch: once the cell is steady under a force, record its diameters and apply the next force, within the
   // step (before its callbacks), so that a checkpoint of this step already holds the next force.
   auto sweep_update = [&] {
@@ -327,6 +346,7 @@ int run_command(const RunOptions& options, std::ostream& out, std::ostream& err)
   };
   auto step_once = [&] {
     last = sim.advance(log);
+    stepping += last.wall_seconds;
     ++done;
     if (sweep) sweep_update();
     for (auto& c : callbacks)
@@ -371,6 +391,7 @@ int run_command(const RunOptions& options, std::ostream& out, std::ostream& err)
     if (const double wall = sim.op().min_wall_distance(); std::isfinite(wall))
       out << ", closest approach of a node to a wall " << wall;
   out << "\n";
+  if (done > 0) out << step_profile(sim.op().timings(), stepping) << "\n";
   for (std::size_t m = 0; m < sim.num_membranes(); ++m) {
     const auto X = sim.op().membrane_positions(m);
     const auto g = measure(sim.mesh(m), X);
