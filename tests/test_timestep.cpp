@@ -8,7 +8,6 @@
 #include "immerse/core/Error.hpp"
 #include "immerse/timestep/AdaptiveStepper.hpp"
 #include "immerse/timestep/MembraneIntegrator.hpp"
-#include "immerse/timestep/ThetaResidual.hpp"
 #include "immerse/verify/Convergence.hpp"
 
 using namespace immerse;
@@ -145,25 +144,6 @@ TEST(Integrators, JfnkCountsIterationsAndFluidSolves) {
   // One g(X) per Newton iterate plus one per GMRES product (eq. 36).
   EXPECT_EQ(st.fluid_solves, static_cast<std::size_t>(1 + st.newton_its + st.gmres_its));
   EXPECT_LT(st.residual, 1e-8);
-}
-
-// The initial guess (ThetaResidual::initial_guess) errs by O(dt^3) against the converged step: one order better
-// than the paper's 2X^n - X^{n-1}, which is what lets one Newton iteration suffice on smooth motion.
-TEST(Integrators, InitialGuessIsThirdOrderAccurate) {
-  std::vector<double> e;
-  for (int steps : {20, 40, 80}) {
-    auto op = make_toy();
-    const double dt = 0.5 / steps;
-    auto jfnk = make_integrator("jfnk", {});
-    for (int i = 0; i < steps; ++i) ASSERT_TRUE(jfnk->step(op, dt).converged);
-    std::vector<double> guess(op.size());
-    ThetaResidual(op, dt, 0.5).initial_guess(jfnk->previous_velocity(), jfnk->previous_dt(), guess);
-    ASSERT_TRUE(jfnk->step(op, dt).converged);
-    e.push_back(std::abs(guess[0] - op.positions()[0]));
-  }
-  const double p = verify::min_observed_order(e);
-  std::cout << "initial guess errors " << e[0] << ", " << e[1] << ", " << e[2] << ": order " << p << "\n";
-  EXPECT_GE(p, 2.8);
 }
 
 TEST(Integrators, BadNamesAndSettingsAreRejected) {

@@ -84,6 +84,26 @@ FastSolver::~FastSolver() {
   fftw_free(buf_);
 }
 
+void FastSolver::set_symbol(double alpha, double beta) {
+  const int mx = m_[0], my = m_[1], mz = m_[2];
+  const double* lx = lambda_[0].data();
+  const double* ly = lambda_[1].data();
+  const double* lz = lambda_[2].data();
+  inverse_.resize(static_cast<std::size_t>(mx) * my * mz);
+  double* const inv = inverse_.data();
+#pragma omp parallel for collapse(2) schedule(static) if (threaded_)
+  for (int k = 0; k < mz; ++k)
+    for (int j = 0; j < my; ++j) {
+      double* const row = inv + mx * (j + my * static_cast<std::size_t>(k));
+      for (int i = 0; i < mx; ++i) {
+        const double den = (alpha + beta * (lx[i] + ly[j] + lz[k])) * normalization_;
+        row[i] = den == 0.0 ? 0.0 : 1.0 / den;
+      }
+    }
+  alpha_ = alpha;
+  beta_ = beta;
+}
+
 void FastSolver::solve(Array3& x, double alpha, double beta) {
   const int mx = m_[0], my = m_[1], mz = m_[2];
   const int ox = lo_[0], oy = lo_[1], oz = lo_[2];
@@ -92,22 +112,12 @@ void FastSolver::solve(Array3& x, double alpha, double beta) {
   for (int k = 0; k < mz; ++k)
     for (int j = 0; j < my; ++j)
       for (int i = 0; i < mx; ++i) b[i + mx * (j + my * static_cast<std::size_t>(k))] = x(i + ox, j + oy, k + oz);
+  if (!(alpha == alpha_ && beta == beta_)) set_symbol(alpha, beta);
   fftw_execute(forward_);
-  const double* lx = lambda_[0].data();
-  const double* ly = lambda_[1].data();
-  const double* lz = lambda_[2].data();
-  const double norm = normalization_;
-#pragma omp parallel for collapse(2) schedule(static) if (threaded_)
-  for (int k = 0; k < mz; ++k)
-    for (int j = 0; j < my; ++j) {
-      double* const row = b + mx * (j + my * static_cast<std::size_t>(k));
-      const double lyj = ly[j], lzk = lz[k];
-#pragma omp simd
-      for (int i = 0; i < mx; ++i) {
-        const double den = (alpha + beta * (lx[i] + lyj + lzk)) * norm;
-        row[i] = den == 0.0 ? 0.0 : row[i] / den;
-      }
-    }
+  const double* const inv = inverse_.data();
+  const long total = static_cast<long>(inverse_.size());
+#pragma omp parallel for simd schedule(static) if (threaded_)
+  for (long n = 0; n < total; ++n) b[n] *= inv[n];
   fftw_execute(backward_);
 #pragma omp parallel for collapse(2) schedule(static) if (threaded_)
   for (int k = 0; k < mz; ++k)

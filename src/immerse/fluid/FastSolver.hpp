@@ -10,12 +10,14 @@
 //   wall axis, pressure (Neumann)              REDFT10 / REDFT01, N           λ = −(4/h²) sin²(π k/2N), k = 0..N−1
 // In half-complex order slot s holds frequency s or N−s; sin² is the same for both, so λ(s) = −(4/h²) sin²(π s/N).
 // The operator is homogeneous: wall values must already be in b. x = b / (α + β Σλ) in transform space; a zero
-// denominator (the constant null mode of the periodic/Neumann Poisson problem) gives a zero coefficient.
+// denominator (the constant null mode of the periodic/Neumann Poisson problem) gives a zero coefficient. The
+// factors 1/(α + β Σλ) are tabulated for the last (α, β) (a time step changes them; the step after uses the table).
 //
 // One in-place 3D r2r plan pair per solver, created once (see FftPlanning) and executed with FFTW threads
 // (omp_get_max_threads() at construction; one thread below MacGeom::kMinCellsForThreads unknowns). Not reentrant:
 // solve() uses an internal buffer. A distributed (FFTW-MPI) backend can replace this class behind the same solve().
 #include <array>
+#include <cmath>
 #include <vector>
 
 #include "immerse/core/Array3.hpp"
@@ -55,10 +57,15 @@ class FastSolver {
   const std::array<int, 3>& first() const { return lo_; }
 
  private:
+  /// Tabulates 1 / ((α + β Σλ) N) (0 for a zero denominator) for this α, β.
+  void set_symbol(double alpha, double beta);
+
   Layout layout_;
   std::array<int, 3> m_{}, lo_{};
   std::array<std::vector<double>, 3> lambda_;  // eigenvalues of the 3-point second difference per axis
   double normalization_ = 1;                   // product over axes of N (DFT) or 2N (others)
+  std::vector<double> inverse_;                // 1 / ((α + β Σλ) N) per transform slot, for alpha_, beta_
+  double alpha_ = NAN, beta_ = NAN;
   bool threaded_ = false;
   double* buf_ = nullptr;
   fftw_plan_s* forward_ = nullptr;

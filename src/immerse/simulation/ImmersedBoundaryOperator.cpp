@@ -91,6 +91,10 @@ void ImmersedBoundaryOperator::membrane_force_density(std::span<const Vec3> X, F
 void ImmersedBoundaryOperator::trial_velocity(std::span<const double> Xf, double theta, std::span<const double> Xi,
                                               double dt, std::span<double> U) {
   trial_X_.clear();
+  if (theta < 1.0 && !start_valid_) {
+    membrane_force_density(X_, force_start_);
+    start_valid_ = true;
+  }
   membrane_force_density(nodes(Xf), force_);
   trial_X_.assign(Xf.begin(), Xf.end());
   timed(timings_.fluid, [&] {
@@ -123,10 +127,9 @@ void ImmersedBoundaryOperator::commit(std::span<const double> X, double) {
   std::copy(Xn.begin(), Xn.end(), X_.begin());
   timed(timings_.interpolate, [&] { coupler_.interpolate_velocity(committed_.u, X_, U_); });
   // An implicit step's last trial was driven by X^{n+1} itself: its S(X^{n+1}) f(X^{n+1}) is the next step's start.
-  if (std::ranges::equal(X, trial_X_))
-    std::swap(force_start_, force_);
-  else
-    membrane_force_density(X_, force_start_);
+  // Otherwise the start force is computed when a trial first needs it (never by the explicit schemes, theta = 1).
+  start_valid_ = std::ranges::equal(X, trial_X_);
+  if (start_valid_) std::swap(force_start_, force_);
   trial_X_.clear();
 }
 
@@ -142,7 +145,7 @@ void ImmersedBoundaryOperator::set_applied_forces(std::size_t m, const std::vect
   if (F.size() != offset_[m + 1] - offset_[m]) throw std::logic_error("set_applied_forces: one force per node");
   std::copy(F.begin(), F.end(), applied_.begin() + static_cast<std::ptrdiff_t>(offset_[m]));
   trial_X_.clear();
-  membrane_force_density(X_, force_start_);
+  start_valid_ = false;
 }
 
 double ImmersedBoundaryOperator::min_wall_distance() const { return immerse::min_wall_distance(fluid_.grid(), X_); }

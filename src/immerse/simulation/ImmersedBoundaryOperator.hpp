@@ -6,9 +6,9 @@
 //   u^{n+1}   one projection step driven by F^{n+1/2}  NavierStokesSolver::step        (eqs. 9-13)
 //   J(X) u    interpolated back to the nodes          IBCoupler::interpolate_velocity  (eq. 14)
 //
-// with F^{n+1/2} = (1 - theta) S(X^n) f(X^n) + theta S(Xf) f(Xf); S(X^n) f(X^n) is computed once per step (at
-// commit, or taken over from the last trial when that was driven by X^{n+1}, as an implicit step's is). The
-// committed fluid state is never modified by trial steps; commit() swaps the last trial in.
+// with F^{n+1/2} = (1 - theta) S(X^n) f(X^n) + theta S(Xf) f(Xf); S(X^n) f(X^n) is taken over from the last trial
+// when that was driven by X^{n+1} (as an implicit step's is), else computed once, when a trial with theta < 1
+// first needs it. The committed fluid state is never modified by trial steps; commit() swaps the last trial in.
 // All membranes' nodes are concatenated in one array; errors name the membrane and its local node or element.
 #include <vector>
 
@@ -54,7 +54,7 @@ class ImmersedBoundaryOperator final : public CoupledOperator {
   /// Smallest distance of any node to a wall (infinity without walls).
   double min_wall_distance() const;
   /// External nodal forces (N) on membrane m, added to its elastic force from now on (e.g. optical tweezers,
-  /// §4.3). The start-of-step force S(X^n) f(X^n) is recomputed with them.
+  /// §4.3). The start-of-step force S(X^n) f(X^n) will be recomputed with them.
   void set_applied_forces(std::size_t m, const std::vector<Vec3>& F);
 
  private:
@@ -75,7 +75,8 @@ class ImmersedBoundaryOperator final : public CoupledOperator {
   std::vector<std::size_t> offset_;  ///< first node of membrane m in the concatenated arrays
   std::vector<Vec3> X_, U_;          ///< committed positions and node velocities
   FluidState committed_, trial_;
-  FaceField force_start_;       ///< S(X^n) f(X^n)
+  FaceField force_start_;       ///< S(X^n) f(X^n), when start_valid_
+  bool start_valid_ = true;
   FaceField force_;             ///< S(Xf) f(Xf) of the last trial
   FaceField mixed_;             ///< F^{n+1/2} of the last trial (theta < 1)
   std::vector<double> trial_X_;  ///< the Xf of the last trial (empty when it cannot be reused at commit)

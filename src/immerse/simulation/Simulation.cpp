@@ -302,7 +302,7 @@ io::Checkpoint Simulation::checkpoint() const {
     const auto& R = references_[m];
     ck.put_array(membrane_name(m) + ".reference", {&R[0].x, &R[0].x + 3 * R.size()}, {R.size(), 3});
   }
-  ck.put_array("integrator.previous_velocity", integrator_->previous_velocity());
+  ck.put_array("integrator.previous_positions", integrator_->previous_positions());
   ck.put_double("integrator.previous_dt", integrator_->previous_dt());
   ck.put_double("stepper.dt", stepper_.dt());
   ck.put_int("stepper.successes", stepper_.successes());
@@ -355,7 +355,7 @@ void Simulation::restore(const io::Checkpoint& ck) {
   std::vector<const ElasticMembrane*> ms;
   for (auto& m : membranes_) ms.push_back(m.get());
   op_ = std::make_unique<ImmersedBoundaryOperator>(fluid_, coupler_, ms, X, std::move(f));
-  integrator_->set_history(ck.array("integrator.previous_velocity"), ck.get_double("integrator.previous_dt"));
+  integrator_->set_history(ck.array("integrator.previous_positions"), ck.get_double("integrator.previous_dt"));
   stepper_.set_state(ck.get_double("stepper.dt"), static_cast<int>(ck.get_int("stepper.successes")));
   step_ = ck.get_int("step");
 }

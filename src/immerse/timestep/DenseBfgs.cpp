@@ -35,7 +35,7 @@ StepStats DenseBfgs::step(CoupledOperator& op, double dt) {
   for (std::size_t i = 0; i < n; ++i) H_[i * n + i] = 1.0;
 
   try {
-    g.initial_guess(previous_velocity(), previous_dt(), X_);
+    g.initial_guess(previous_positions(), previous_dt(), X_);
     g(X_, g_);
     for (int k = 0;; ++k) {
       stats.residual = std::sqrt(dot(g_, g_) / dot(X_, X_));

@@ -28,24 +28,24 @@ class MembraneIntegrator {
   virtual StepStats step(CoupledOperator& op, double dt) = 0;
   virtual std::string name() const = 0;
 
-  /// Node velocity U^{n-1} and step dt^{n-1} before the committed ones, used by the implicit schemes' initial
-  /// guess (ThetaResidual::initial_guess); empty before the first step. Saved in checkpoints.
-  const std::vector<double>& previous_velocity() const { return prev_U_; }
+  /// Positions X^{n-1} and step dt^{n-1} before the committed ones, used by the implicit schemes' initial guess
+  /// X^(0) = X^n + (dt/dt^{n-1})(X^n - X^{n-1}) (step 1 of §3); empty before the first step. Saved in checkpoints.
+  const std::vector<double>& previous_positions() const { return prev_X_; }
   double previous_dt() const { return prev_dt_; }
-  void set_history(std::vector<double> previous_velocity, double previous_dt) {
-    prev_U_ = std::move(previous_velocity);
+  void set_history(std::vector<double> previous_positions, double previous_dt) {
+    prev_X_ = std::move(previous_positions);
     prev_dt_ = previous_dt;
   }
 
  protected:
-  /// Records U^n as history just before the operator commits X^{n+1}.
+  /// Records X^n as history just before the operator commits X^{n+1}.
   void remember(const CoupledOperator& op, double dt) {
-    prev_U_.assign(op.node_velocity().begin(), op.node_velocity().end());
+    prev_X_.assign(op.positions().begin(), op.positions().end());
     prev_dt_ = dt;
   }
 
  private:
-  std::vector<double> prev_U_;
+  std::vector<double> prev_X_;
   double prev_dt_ = 0;
 };
 

@@ -132,7 +132,7 @@ StepStats SnesIntegrator::step(CoupledOperator& op, double dt) {
   IMMERSE_PETSC(VecGetArray(x_, &xs));
   {
     std::vector<double> X0(n_);
-    residual.initial_guess(previous_velocity(), previous_dt(), X0);
+    residual.initial_guess(previous_positions(), previous_dt(), X0);
     for (std::size_t i = 0; i < n_; ++i) xs[i] = X0[i] / scale_;
   }
   IMMERSE_PETSC(VecRestoreArray(x_, &xs));

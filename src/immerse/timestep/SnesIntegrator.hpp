@@ -2,7 +2,7 @@
 // Implicit membrane update solved with PETSc SNES (paper §2.4.2-2.4.3, algorithm of §3):
 //
 //   solve g(X^{n+1}) = 0, g from eq. (31) (theta-method; theta = 1/2 is the trapezoidal rule (29)),
-//   starting from ThetaResidual::initial_guess, stopping when ||g|| / ||X|| < newton_rtol (§4: 1e-8).
+//   starting from X^(0) = 2X^n - X^{n-1}, stopping when ||g|| / ||X|| < newton_rtol (§4: 1e-8).
 //
 // Method::NewtonKrylov ("jfnk", §2.4.3): Newton steps (33)-(34), each solved by unpreconditioned GMRES
 // (relative tolerance 1e-3, §4; it also stops once its residual, the linearized ||g|| after the step, is below

@@ -33,18 +33,14 @@ class ThetaResidual {
   bool trial_matches(std::span<const double> X) const {
     return last_X_.size() == X.size() && std::equal(X.begin(), X.end(), last_X_.begin());
   }
-  /// Initial guess (step 1 of §3, one order better): the scheme (31) itself with U^{n+1} extrapolated linearly
-  /// from the node velocities U^{n-1}, U^n,
-  ///   X^(0) = X^n + dt [ (1 - theta) U^n + theta (U^n + (dt/dt^{n-1}) (U^n - U^{n-1})) ],
-  /// an error O(dt^3) where the paper's 2X^n - X^{n-1} errs by O(dt^2) (for theta = 1/2 and equal steps it is
-  /// X^{n-1} + 2 dt U^n, the Adams-Bashforth-2 predictor of the trapezoidal rule); X^n + dt U^n on the first step.
-  void initial_guess(const std::vector<double>& previous_velocity, double previous_dt, std::span<double> X0) const {
+  /// Initial guess X^(0) = X^n + (dt/dt^{n-1})(X^n - X^{n-1}) (step 1 of §3: 2X^n - X^{n-1} for equal steps);
+  /// X^n + dt U^n on the first step.
+  void initial_guess(const std::vector<double>& previous, double previous_dt, std::span<double> X0) const {
     const auto Xn = op_.positions();
     const auto Un = op_.node_velocity();
-    if (previous_velocity.size() == Xn.size() && previous_dt > 0) {
+    if (previous.size() == Xn.size() && previous_dt > 0) {
       const double r = dt_ / previous_dt;
-      for (std::size_t i = 0; i < Xn.size(); ++i)
-        X0[i] = Xn[i] + dt_ * (Un[i] + theta_ * r * (Un[i] - previous_velocity[i]));
+      for (std::size_t i = 0; i < Xn.size(); ++i) X0[i] = Xn[i] + r * (Xn[i] - previous[i]);
     } else {
       for (std::size_t i = 0; i < Xn.size(); ++i) X0[i] = Xn[i] + dt_ * Un[i];
     }
