@@ -42,7 +42,7 @@ struct Cost {
   double per_step() const { return seconds / double(steps); }
   // Where the time went, per step: membrane forces, spreading, fluid, interpolation, the rest.
   void print_profile(const char* scheme) const {
-    const double n = double(steps), rest = seconds - parts.force - parts.spread - parts.fluid - parts.interpolate;
+    const double n = double(steps), rest = seconds - parts.total();
     std::printf("%s profile, ms per step (%% of the step): membrane forces %.0f (%.0f %%), spreading %.0f (%.0f %%), "
                 "fluid %.0f (%.0f %%), interpolation %.0f (%.0f %%), the rest %.0f (%.0f %%)\n",
                 scheme, 1e3 * parts.force / n, 100 * parts.force / seconds, 1e3 * parts.spread / n,
@@ -68,6 +68,7 @@ io::Config channel_config(const std::string& file, const std::string& scheme, do
 Cost run(const io::Config& config, long steps) {
   Simulation sim(config);
   Cost c;
+  const StepTimings start = sim.op().timings();
   const auto t0 = Clock::now();
   while (!sim.finished() && (steps <= 0 || c.steps < steps)) {
     const StepRecord r = sim.advance([](const std::string& msg) { std::printf("  %s\n", msg.c_str()); });
@@ -77,7 +78,7 @@ Cost run(const io::Config& config, long steps) {
     c.gmres += double(r.stats.gmres_its);
   }
   c.seconds = std::chrono::duration<double>(Clock::now() - t0).count();
-  c.parts = sim.op().timings();
+  c.parts = sim.op().timings().since(start);
   return c;
 }
 

@@ -116,7 +116,7 @@ void FastSolver::solve(Array3& x, double alpha, double beta) {
   fftw_execute(forward_);
   const double* const inv = inverse_.data();
   const long total = static_cast<long>(inverse_.size());
-#pragma omp parallel for simd schedule(static) if (threaded_)
+#pragma omp parallel for simd schedule(static) if (parallel : threaded_)
   for (long n = 0; n < total; ++n) b[n] *= inv[n];
   fftw_execute(backward_);
 #pragma omp parallel for collapse(2) schedule(static) if (threaded_)

@@ -17,7 +17,7 @@
 // (omp_get_max_threads() at construction; one thread below MacGeom::kMinCellsForThreads unknowns). Not reentrant:
 // solve() uses an internal buffer. A distributed (FFTW-MPI) backend can replace this class behind the same solve().
 #include <array>
-#include <cmath>
+#include <limits>
 #include <vector>
 
 #include "immerse/core/Array3.hpp"
@@ -65,7 +65,7 @@ class FastSolver {
   std::array<std::vector<double>, 3> lambda_;  // eigenvalues of the 3-point second difference per axis
   double normalization_ = 1;                   // product over axes of N (DFT) or 2N (others)
   std::vector<double> inverse_;                // 1 / ((α + β Σλ) N) per transform slot, for alpha_, beta_
-  double alpha_ = NAN, beta_ = NAN;
+  double alpha_ = std::numeric_limits<double>::quiet_NaN(), beta_ = alpha_;
   bool threaded_ = false;
   double* buf_ = nullptr;
   fftw_plan_s* forward_ = nullptr;

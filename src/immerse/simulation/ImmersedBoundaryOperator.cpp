@@ -4,8 +4,8 @@
 
 #include <algorithm>
 #include <chrono>
-#include <exception>
 #include <cmath>
+#include <exception>
 #include <limits>
 #include <string>
 
@@ -34,8 +34,7 @@ ImmersedBoundaryOperator::ImmersedBoundaryOperator(NavierStokesSolver& fluid, IB
       membranes_(std::move(membranes)),
       committed_(std::move(fluid_state)),
       force_start_(fluid.grid()),
-      force_(fluid.grid()),
-      mixed_(fluid.grid()) {
+      force_(fluid.grid()) {
   if (X0.size() != membranes_.size()) throw std::logic_error("ImmersedBoundaryOperator: one position array per membrane");
   for (std::size_t m = 0; m < membranes_.size(); ++m) {
     if (X0[m].size() != membranes_[m]->num_nodes())
@@ -66,20 +65,24 @@ void ImmersedBoundaryOperator::nodal_force(std::size_t m, std::span<const Vec3> 
   for (std::size_t i = 0; i < Fm_[m].size(); ++i) F_[offset_[m] + i] = Fm_[m][i] + applied_[offset_[m] + i];
 }
 
-// With many membranes each thread takes whole membranes (each evaluated without inner parallelism: no barrier
-// per pass); with few, one membrane at a time with OpenMP inside ElasticMembrane. A membrane's forces do not
+// With many membranes each thread takes whole membranes (each evaluated with one thread: no barrier per pass,
+// whatever OMP_MAX_ACTIVE_LEVELS says); with few, one membrane at a time with OpenMP inside ElasticMembrane. A membrane's forces do not
 // depend on the thread count either way, and the error reported is that of the lowest-numbered failing membrane.
 void ImmersedBoundaryOperator::membrane_force_density(std::span<const Vec3> X, FaceField& f) {
   const int M = static_cast<int>(membranes_.size());
   const bool across = M >= 2 * omp_get_max_threads();
   std::vector<std::exception_ptr> error(membranes_.size());
   timed(timings_.force, [&] {
-#pragma omp parallel for schedule(dynamic) if (across)
-    for (int m = 0; m < M; ++m) {
-      try {
-        nodal_force(static_cast<std::size_t>(m), X);
-      } catch (...) {
-        error[m] = std::current_exception();
+#pragma omp parallel if (across)
+    {
+      if (across) omp_set_num_threads(1);  // for the regions nested in this thread's membranes
+#pragma omp for schedule(dynamic)
+      for (int m = 0; m < M; ++m) {
+        try {
+          nodal_force(static_cast<std::size_t>(m), X);
+        } catch (...) {
+          error[m] = std::current_exception();
+        }
       }
     }
   });
@@ -99,6 +102,7 @@ void ImmersedBoundaryOperator::trial_velocity(std::span<const double> Xf, double
   trial_X_.assign(Xf.begin(), Xf.end());
   timed(timings_.fluid, [&] {
     if (theta < 1.0) {
+      if (mixed_[0].size() == 0) mixed_ = FaceField(fluid_.grid());
       for (int d = 0; d < 3; ++d) {
         auto& a = mixed_[d];
         const auto& b = force_[d];

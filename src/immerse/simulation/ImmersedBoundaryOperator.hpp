@@ -15,17 +15,10 @@
 #include "immerse/coupling/IBCoupler.hpp"
 #include "immerse/fluid/NavierStokesSolver.hpp"
 #include "immerse/membrane/ElasticMembrane.hpp"
+#include "immerse/simulation/StepTimings.hpp"
 #include "immerse/timestep/CoupledOperator.hpp"
 
 namespace immerse {
-
-/// Wall time (seconds) spent so far in each part of the coupled step: the profile of a run by component.
-struct StepTimings {
-  double force = 0;        ///< membrane forces f(X) of all membranes (§2.3)
-  double spread = 0;       ///< S(X) f (eq. 6)
-  double fluid = 0;        ///< the fluid step (eqs. 9-13) with its force F^{n+1/2}
-  double interpolate = 0;  ///< J(X) u (eq. 14)
-};
 
 class ImmersedBoundaryOperator final : public CoupledOperator {
  public:
@@ -45,6 +38,7 @@ class ImmersedBoundaryOperator final : public CoupledOperator {
   std::size_t fluid_solves() const override { return solves_; }
 
   const FluidState& fluid_state() const { return committed_; }
+  /// Wall time spent so far in each part of the coupled step (since construction, which evaluates the forces once).
   const StepTimings& timings() const { return timings_; }
   std::size_t num_membranes() const { return membranes_.size(); }
   /// Committed positions of membrane m.
@@ -78,7 +72,7 @@ class ImmersedBoundaryOperator final : public CoupledOperator {
   FaceField force_start_;       ///< S(X^n) f(X^n), when start_valid_
   bool start_valid_ = true;
   FaceField force_;             ///< S(Xf) f(Xf) of the last trial
-  FaceField mixed_;             ///< F^{n+1/2} of the last trial (theta < 1)
+  FaceField mixed_;             ///< F^{n+1/2} of the last trial (allocated by the first trial with theta < 1)
   std::vector<double> trial_X_;  ///< the Xf of the last trial (empty when it cannot be reused at commit)
   std::vector<Vec3> F_;                                 ///< nodal forces, all membranes
   std::vector<Vec3> applied_;                           ///< external nodal forces, all membranes

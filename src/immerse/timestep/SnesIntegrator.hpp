@@ -6,8 +6,8 @@
 //
 // Method::NewtonKrylov ("jfnk", §2.4.3): Newton steps (33)-(34), each solved by unpreconditioned GMRES
 // (relative tolerance 1e-3, §4; it also stops once its residual, the linearized ||g|| after the step, is below
-// half the Newton tolerance, newton_rtol ||X^(0)|| / 2: further iterations could not change whether the step is
-// accepted) whose matrix-vector product is the finite difference (36)
+// half the Newton tolerance, newton_rtol ||X^(0)|| / 2: a heuristic, the nonlinear and finite-difference terms
+// of the step are left the other half) whose matrix-vector product is the finite difference (36)
 //   J(X) y ~ (g(X + eps y) - g(X)) / eps,   eps = sqrt((1 + ||X||) eps_mach) / ||y||   (37),
 // which is PETSc's matrix-free Jacobian with the Walker-Pernice parameter (MATMFFD_WP). Full Newton steps.
 // Method::LimitedMemoryBFGS ("lbfgs"): PETSc's limited-memory quasi-Newton (SNESQN, LBFGS) with H_0 = I, the

@@ -1,0 +1,21 @@
+#pragma once
+// Wall time spent in each part of the coupled step of §3 (ImmersedBoundaryOperator): the profile of a run by
+// component. The nonlinear solver's own work (vector operations, the finite differences of eq. 36) is what a
+// caller's total wall time leaves over.
+
+namespace immerse {
+
+struct StepTimings {
+  double force = 0;        ///< membrane forces f(X) of all membranes (§2.3), seconds
+  double spread = 0;       ///< S(X) f (eq. 6)
+  double fluid = 0;        ///< the fluid step (eqs. 9-13) with its force F^{n+1/2}
+  double interpolate = 0;  ///< J(X) u (eq. 14)
+
+  double total() const { return force + spread + fluid + interpolate; }
+  /// The time spent between two readings `earlier` and *this of the same operator.
+  StepTimings since(const StepTimings& earlier) const {
+    return {force - earlier.force, spread - earlier.spread, fluid - earlier.fluid, interpolate - earlier.interpolate};
+  }
+};
+
+}  // namespace immerse
