@@ -25,7 +25,7 @@ void init_fftw_threads() {
 
 }  // namespace
 
-FastSolver::FastSolver(const Grid& grid, Layout layout, FftPlanning planning) : layout_(layout) {
+FastSolver::FastSolver(const Grid& grid, Layout layout, FftPlanning planning, Array3* in_place) : layout_(layout) {
   init_fftw_threads();
   const int comp = static_cast<int>(layout);  // 3: pressure
   const double h = grid.h();
@@ -66,22 +66,29 @@ FastSolver::FastSolver(const Grid& grid, Layout layout, FftPlanning planning) : 
   }
   const std::size_t total = static_cast<std::size_t>(m_[0]) * m_[1] * m_[2];
   threaded_ = static_cast<long>(total) >= MacGeom::kMinCellsForThreads;
-  buf_ = fftw_alloc_real(total);
-  if (buf_ == nullptr) throw std::bad_alloc();
+  const bool whole = lo_ == std::array<int, 3>{0, 0, 0};  // the unknowns are the whole array
+  if (in_place && whole && in_place->nx() == m_[0] && in_place->ny() == m_[1] && in_place->nz() == m_[2]) {
+    target_ = in_place;
+    data_ = in_place->data();
+  } else {
+    buf_ = fftw_alloc_real(total);
+    if (buf_ == nullptr) throw std::bad_alloc();
+    data_ = buf_;
+  }
   // Array3 is x fastest: in FFTW's row-major terms the dimensions are {z, y, x}.
   const int dims[3] = {m_[2], m_[1], m_[0]};
   const fftw_r2r_kind kf[3] = {fwd[2], fwd[1], fwd[0]}, kb[3] = {bwd[2], bwd[1], bwd[0]};
   const unsigned flags = planning == FftPlanning::Measure ? FFTW_MEASURE : FFTW_ESTIMATE;
   fftw_plan_with_nthreads(threaded_ ? omp_get_max_threads() : 1);
-  forward_ = fftw_plan_r2r(3, dims, buf_, buf_, kf, flags);
-  backward_ = fftw_plan_r2r(3, dims, buf_, buf_, kb, flags);
+  forward_ = fftw_plan_r2r(3, dims, data_, data_, kf, flags);
+  backward_ = fftw_plan_r2r(3, dims, data_, data_, kb, flags);
   if (forward_ == nullptr || backward_ == nullptr) throw std::runtime_error("FFTW could not plan a fast solver");
 }
 
 FastSolver::~FastSolver() {
   fftw_destroy_plan(forward_);
   fftw_destroy_plan(backward_);
-  fftw_free(buf_);
+  if (buf_) fftw_free(buf_);
 }
 
 void FastSolver::set_symbol(double alpha, double beta) {
@@ -107,11 +114,14 @@ void FastSolver::set_symbol(double alpha, double beta) {
 void FastSolver::solve(Array3& x, double alpha, double beta) {
   const int mx = m_[0], my = m_[1], mz = m_[2];
   const int ox = lo_[0], oy = lo_[1], oz = lo_[2];
-  double* b = buf_;
+  double* const b = data_;
+  if (target_ && &x != target_) throw std::logic_error("FastSolver::solve: this solver works in place on another array");
+  if (!target_) {
 #pragma omp parallel for collapse(2) schedule(static) if (threaded_)
-  for (int k = 0; k < mz; ++k)
-    for (int j = 0; j < my; ++j)
-      for (int i = 0; i < mx; ++i) b[i + mx * (j + my * static_cast<std::size_t>(k))] = x(i + ox, j + oy, k + oz);
+    for (int k = 0; k < mz; ++k)
+      for (int j = 0; j < my; ++j)
+        for (int i = 0; i < mx; ++i) b[i + mx * (j + my * static_cast<std::size_t>(k))] = x(i + ox, j + oy, k + oz);
+  }
   if (!(alpha == alpha_ && beta == beta_)) set_symbol(alpha, beta);
   fftw_execute(forward_);
   const double* const inv = inverse_.data();
@@ -119,6 +129,7 @@ void FastSolver::solve(Array3& x, double alpha, double beta) {
 #pragma omp parallel for simd schedule(static) if (parallel : threaded_)
   for (long n = 0; n < total; ++n) b[n] *= inv[n];
   fftw_execute(backward_);
+  if (target_) return;
 #pragma omp parallel for collapse(2) schedule(static) if (threaded_)
   for (int k = 0; k < mz; ++k)
     for (int j = 0; j < my; ++j)

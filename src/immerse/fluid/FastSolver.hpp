@@ -14,8 +14,9 @@
 // factors 1/(α + β Σλ) are tabulated for the last (α, β) (a time step changes them; the step after uses the table).
 //
 // One in-place 3D r2r plan pair per solver, created once (see FftPlanning) and executed with FFTW threads
-// (omp_get_max_threads() at construction; one thread below MacGeom::kMinCellsForThreads unknowns). Not reentrant:
-// solve() uses an internal buffer. A distributed (FFTW-MPI) backend can replace this class behind the same solve().
+// (omp_get_max_threads() at construction; one thread below MacGeom::kMinCellsForThreads unknowns). The plans work
+// on an internal buffer (the unknowns copied in and out), or, for a solver made for one array whose unknowns are
+// the whole array (every layout but a face-normal component on a wall axis), on that array itself. Not reentrant. A distributed (FFTW-MPI) backend can replace this class behind the same solve().
 #include <array>
 #include <limits>
 #include <vector>
@@ -39,16 +40,20 @@ inline Layout velocity_layout(int d) { return static_cast<Layout>(d); }
 
 class FastSolver {
  public:
-  FastSolver(const Grid& grid, Layout layout, FftPlanning planning = FftPlanning::Measure);
+  /// With `in_place`, a solver that only ever solves in that array (whose values planning may overwrite): it
+  /// transforms the array itself when its unknowns are the whole array, saving two copies per solve.
+  FastSolver(const Grid& grid, Layout layout, FftPlanning planning = FftPlanning::Measure,
+             Array3* in_place = nullptr);
   ~FastSolver();
   FastSolver(const FastSolver&) = delete;
   FastSolver& operator=(const FastSolver&) = delete;
 
   /// Overwrites the unknowns of x (shape of the layout: face_shape(d) or cell_shape) with the solution of
   /// (α I + β ∇_h²) x = b, b being the values of x on entry. Wall faces of a face-normal layout are untouched.
+  /// A solver made `in_place` for an array accepts only that array (std::logic_error otherwise).
   void solve(Array3& x, double alpha, double beta);
 
-  /// Runs only the forward and backward transforms on the work buffer (reference cost for benchmarks).
+  /// Runs only the forward and backward transforms on the work array (reference cost for benchmarks).
   void transform_round_trip();
 
   Layout layout() const { return layout_; }
@@ -67,7 +72,9 @@ class FastSolver {
   std::vector<double> inverse_;                // 1 / ((α + β Σλ) N) per transform slot, for alpha_, beta_
   double alpha_ = std::numeric_limits<double>::quiet_NaN(), beta_ = alpha_;
   bool threaded_ = false;
-  double* buf_ = nullptr;
+  double* buf_ = nullptr;      // the work buffer, or null when working in place
+  Array3* target_ = nullptr;   // the array solved in place, if any
+  double* data_ = nullptr;     // where the transforms run: buf_ or target_'s data
   fftw_plan_s* forward_ = nullptr;
   fftw_plan_s* backward_ = nullptr;
 };

@@ -146,7 +146,8 @@ NavierStokesSolver::NavierStokesSolver(const Grid& grid, const FluidParams& para
       div_(grid.n(0), grid.n(1), grid.n(2)),
       phi_(grid.n(0), grid.n(1), grid.n(2)) {
   params_.validate(grid_);
-  for (int l = 0; l < 4; ++l) solvers_[l] = std::make_unique<FastSolver>(grid_, static_cast<Layout>(l), planning);
+  for (int l = 0; l < 4; ++l)
+    solvers_[l] = std::make_unique<FastSolver>(grid_, static_cast<Layout>(l), planning, l < 3 ? &ustar_[l] : &phi_);
 }
 
 FluidState NavierStokesSolver::initial_state() const {

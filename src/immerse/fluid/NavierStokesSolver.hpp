@@ -29,6 +29,8 @@ class NavierStokesSolver {
  public:
   /// Validates the parameters against the grid (InputError) and plans the four fast solvers.
   NavierStokesSolver(const Grid& grid, const FluidParams& params, FftPlanning planning = FftPlanning::Measure);
+  NavierStokesSolver(const NavierStokesSolver&) = delete;  // its fast solvers transform its own arrays in place
+  NavierStokesSolver& operator=(const NavierStokesSolver&) = delete;
 
   const Grid& grid() const { return grid_; }
   const FluidParams& params() const { return params_; }
