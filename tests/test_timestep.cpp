@@ -180,6 +180,7 @@ class Fragile final : public CoupledOperator {
   void committed_velocity(std::span<const double> Xi, std::span<double> U) override {
     in_.committed_velocity(Xi, U);
   }
+  bool trial_matches(std::span<const double> X) const override { return in_.trial_matches(X); }
   void commit(std::span<const double> X, double dt) override { in_.commit(X, dt); }
   std::size_t fluid_solves() const override { return in_.fluid_solves(); }
 

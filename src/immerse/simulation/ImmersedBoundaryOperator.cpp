@@ -99,7 +99,6 @@ void ImmersedBoundaryOperator::trial_velocity(std::span<const double> Xf, double
     start_valid_ = true;
   }
   membrane_force_density(nodes(Xf), force_);
-  trial_X_.assign(Xf.begin(), Xf.end());
   timed(timings_.fluid, [&] {
     if (theta < 1.0) {
       if (mixed_[0].size() == 0) mixed_ = FaceField(fluid_.grid());
@@ -117,6 +116,7 @@ void ImmersedBoundaryOperator::trial_velocity(std::span<const double> Xf, double
   timed(timings_.interpolate, [&] {
     coupler_.interpolate_velocity(trial_.u, nodes(Xi), {reinterpret_cast<Vec3*>(U.data()), U.size() / 3});
   });
+  trial_X_.assign(Xf.begin(), Xf.end());
 }
 
 void ImmersedBoundaryOperator::committed_velocity(std::span<const double> Xi, std::span<double> U) {
@@ -132,7 +132,7 @@ void ImmersedBoundaryOperator::commit(std::span<const double> X, double) {
   timed(timings_.interpolate, [&] { coupler_.interpolate_velocity(committed_.u, X_, U_); });
   // An implicit step's last trial was driven by X^{n+1} itself: its S(X^{n+1}) f(X^{n+1}) is the next step's start.
   // Otherwise the start force is computed when a trial first needs it (never by the explicit schemes, theta = 1).
-  start_valid_ = std::ranges::equal(X, trial_X_);
+  start_valid_ = trial_matches(X);
   if (start_valid_) std::swap(force_start_, force_);
   trial_X_.clear();
 }

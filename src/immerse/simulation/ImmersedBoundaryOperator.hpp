@@ -10,6 +10,8 @@
 // when that was driven by X^{n+1} (as an implicit step's is), else computed once, when a trial with theta < 1
 // first needs it. The committed fluid state is never modified by trial steps; commit() swaps the last trial in.
 // All membranes' nodes are concatenated in one array; errors name the membrane and its local node or element.
+#include <algorithm>
+#include <span>
 #include <vector>
 
 #include "immerse/coupling/IBCoupler.hpp"
@@ -34,6 +36,7 @@ class ImmersedBoundaryOperator final : public CoupledOperator {
   void trial_velocity(std::span<const double> Xf, double theta, std::span<const double> Xi, double dt,
                       std::span<double> U) override;
   void committed_velocity(std::span<const double> Xi, std::span<double> U) override;
+  bool trial_matches(std::span<const double> X) const override { return std::ranges::equal(X, trial_X_); }
   void commit(std::span<const double> X, double dt) override;
   std::size_t fluid_solves() const override { return solves_; }
 
@@ -73,7 +76,7 @@ class ImmersedBoundaryOperator final : public CoupledOperator {
   bool start_valid_ = true;
   FaceField force_;             ///< S(Xf) f(Xf) of the last trial
   FaceField mixed_;             ///< F^{n+1/2} of the last trial (allocated by the first trial with theta < 1)
-  std::vector<double> trial_X_;  ///< the Xf of the last trial (empty when it cannot be reused at commit)
+  std::vector<double> trial_X_;  ///< the Xf of the last completed trial (empty when none can be reused at commit)
   std::vector<Vec3> F_;                                 ///< nodal forces, all membranes
   std::vector<Vec3> applied_;                           ///< external nodal forces, all membranes
   std::vector<std::vector<Vec3>> Xm_, Fm_;              ///< per-membrane scratch for compute_force

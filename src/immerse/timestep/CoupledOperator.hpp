@@ -31,6 +31,9 @@ class CoupledOperator {
                               std::span<double> U) = 0;
   /// U = J(Xi) u^n for the committed fluid velocity.
   virtual void committed_velocity(std::span<const double> Xi, std::span<double> U) = 0;
+  /// True when the last trial_velocity call completed with Xf = X exactly: its trial state is then the one the
+  /// positions X drive, ready to be committed.
+  virtual bool trial_matches(std::span<const double> X) const = 0;
   /// Accepts the step: X^{n+1} = X, the fluid state becomes the trial of the last trial_velocity call, and
   /// U^{n+1} = J(X^{n+1}) u^{n+1}.
   virtual void commit(std::span<const double> X, double dt) = 0;
