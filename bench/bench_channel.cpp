@@ -42,12 +42,7 @@ struct Cost {
   double per_step() const { return seconds / double(steps); }
   // Where the time went, per step: membrane forces, spreading, fluid, interpolation, the rest.
   void print_profile(const char* scheme) const {
-    const double n = double(steps), rest = seconds - parts.total();
-    std::printf("%s profile, ms per step (%% of the step): membrane forces %.0f (%.0f %%), spreading %.0f (%.0f %%), "
-                "fluid %.0f (%.0f %%), interpolation %.0f (%.0f %%), the rest %.0f (%.0f %%)\n",
-                scheme, 1e3 * parts.force / n, 100 * parts.force / seconds, 1e3 * parts.spread / n,
-                100 * parts.spread / seconds, 1e3 * parts.fluid / n, 100 * parts.fluid / seconds,
-                1e3 * parts.interpolate / n, 100 * parts.interpolate / seconds, 1e3 * rest / n, 100 * rest / seconds);
+    std::printf("%s profile, %s\n", scheme, parts.profile(seconds, steps).c_str());
   }
 };
 

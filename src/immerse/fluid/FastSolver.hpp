@@ -16,7 +16,8 @@
 // One in-place 3D r2r plan pair per solver, created once (see FftPlanning) and executed with FFTW threads
 // (omp_get_max_threads() at construction; one thread below MacGeom::kMinCellsForThreads unknowns). The plans work
 // on an internal buffer (the unknowns copied in and out), or, for a solver made for one array whose unknowns are
-// the whole array (every layout but a face-normal component on a wall axis), on that array itself. Not reentrant. A distributed (FFTW-MPI) backend can replace this class behind the same solve().
+// the whole array (every layout but a face-normal component on a wall axis), on that array itself. Not reentrant.
+// A distributed (FFTW-MPI) backend can replace this class behind the same solve().
 #include <array>
 #include <limits>
 #include <vector>

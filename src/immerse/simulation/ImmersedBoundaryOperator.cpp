@@ -66,8 +66,9 @@ void ImmersedBoundaryOperator::nodal_force(std::size_t m, std::span<const Vec3> 
 }
 
 // With many membranes each thread takes whole membranes (each evaluated with one thread: no barrier per pass,
-// whatever OMP_MAX_ACTIVE_LEVELS says); with few, one membrane at a time with OpenMP inside ElasticMembrane. A membrane's forces do not
-// depend on the thread count either way, and the error reported is that of the lowest-numbered failing membrane.
+// whatever OMP_MAX_ACTIVE_LEVELS says); with few, one membrane at a time with OpenMP inside ElasticMembrane. A
+// membrane's forces do not depend on the thread count either way, and the error reported is that of the
+// lowest-numbered failing membrane.
 void ImmersedBoundaryOperator::membrane_force_density(std::span<const Vec3> X, FaceField& f) {
   const int M = static_cast<int>(membranes_.size());
   const bool across = M >= 2 * omp_get_max_threads();

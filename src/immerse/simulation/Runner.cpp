@@ -193,24 +193,6 @@ class Progress {
   clock::time_point t0_, last_;
 };
 
-// Where the stepping time went, by component of the coupled step (the rest: the nonlinear solver's vector work,
-// the stability and clearance checks).
-std::string step_profile(const StepTimings& t, double stepping) {
-  const std::pair<const char*, double> parts[] = {{"membrane forces", t.force},
-                                                  {"spreading", t.spread},
-                                                  {"fluid", t.fluid},
-                                                  {"interpolation", t.interpolate}};
-  std::ostringstream s;
-  s << std::fixed << std::setprecision(1) << "stepping took " << stepping << " s: ";
-  double rest = stepping;
-  for (const auto& [name, seconds] : parts) {
-    s << name << " " << 100 * seconds / stepping << " %, ";
-    rest -= seconds;
-  }
-  s << "the rest " << 100 * rest / stepping << " %";
-  return s.str();
-}
-
 std::string grid_text(const io::Config& c) {
   return "grid " + std::to_string(c.get<int>("grid.nx")) + " x " + std::to_string(c.get<int>("grid.ny")) + " x " +
          std::to_string(c.get<int>("grid.nz"));
@@ -348,7 +330,9 @@ int run_command(const RunOptions& options, std::ostream& out, std::ostream& err)
   };
   auto step_once = [&] {
     const auto t0 = std::chrono::steady_clock::now();
-    const auto add_time = [&] { stepping += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(); };
+    const auto add_time = [&] {
+      stepping += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    };
     try {
       last = sim.advance(log);
     } catch (...) {
@@ -400,7 +384,9 @@ int run_command(const RunOptions& options, std::ostream& out, std::ostream& err)
     if (const double wall = sim.op().min_wall_distance(); std::isfinite(wall))
       out << ", closest approach of a node to a wall " << wall;
   out << "\n";
-  if (stepping > 0) out << step_profile(sim.op().timings().since(timings_at_start), stepping) << "\n";
+  if (done > 0)
+    out << std::fixed << std::setprecision(1) << "stepping took " << stepping << " s, "
+        << sim.op().timings().since(timings_at_start).profile(stepping, done) << std::defaultfloat << "\n";
   for (std::size_t m = 0; m < sim.num_membranes(); ++m) {
     const auto X = sim.op().membrane_positions(m);
     const auto g = measure(sim.mesh(m), X);

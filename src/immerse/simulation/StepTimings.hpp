@@ -2,6 +2,7 @@
 // Wall time spent in each part of the coupled step of §3 (ImmersedBoundaryOperator): the profile of a run by
 // component. The nonlinear solver's own work (vector operations, the finite differences of eq. 36) is what a
 // caller's total wall time leaves over.
+#include <string>
 
 namespace immerse {
 
@@ -16,6 +17,9 @@ struct StepTimings {
   StepTimings since(const StepTimings& earlier) const {
     return {force - earlier.force, spread - earlier.spread, fluid - earlier.fluid, interpolate - earlier.interpolate};
   }
+  /// One line: each part (and the rest of `wall_seconds`, the wall time of `steps` steps) in ms per step and in
+  /// per cent of the wall time.
+  std::string profile(double wall_seconds, long steps) const;
 };
 
 }  // namespace immerse

@@ -63,6 +63,7 @@ void SnesIntegrator::setup(std::size_t n) {
   IMMERSE_PETSC(SNESGetLineSearch(snes_, &ls));
   IMMERSE_PETSC(SNESLineSearchSetType(ls, SNESLINESEARCHBASIC));  // full steps, eq. (34)
   IMMERSE_PETSC(SNESSetSolution(snes_, x_));
+  IMMERSE_PETSC(PetscOptionsHasName(options_, nullptr, "-ksp_atol", &user_atol_));
   IMMERSE_PETSC(SNESSetFromOptions(snes_));
   IMMERSE_PETSC(SNESSetUp(snes_));
   PetscInt left = 0;
@@ -136,9 +137,7 @@ StepStats SnesIntegrator::step(CoupledOperator& op, double dt) {
     for (std::size_t i = 0; i < n_; ++i) xs[i] = X0[i] / scale_;
   }
   IMMERSE_PETSC(VecRestoreArray(x_, &xs));
-  PetscBool user_atol = PETSC_FALSE;
-  IMMERSE_PETSC(PetscOptionsHasName(options_, nullptr, "-ksp_atol", &user_atol));
-  if (method_ == Method::NewtonKrylov && !user_atol) {  // GMRES's absolute stop: half the Newton tolerance
+  if (method_ == Method::NewtonKrylov && !user_atol_) {  // GMRES's absolute stop: half the Newton tolerance
     PetscReal xnorm;
     KSP ksp;
     IMMERSE_PETSC(VecNorm(x_, NORM_2, &xnorm));

@@ -58,6 +58,8 @@ class SnesIntegrator final : public MembraneIntegrator {
   std::vector<double> X_, g_;
   std::exception_ptr callback_error_;
   double last_ratio_ = 0;
+  // -ksp_atol given in petsc_options: it replaces the stop at half the Newton tolerance.
+  PetscBool user_atol_ = PETSC_FALSE;
 };
 
 }  // namespace immerse
