@@ -3,6 +3,7 @@
 // (fields_*.h5 frames, membranes.xdmf, fluid.xdmf) and checkpoint.h5 (the last step).
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <sstream>
 
 #include "PetscEnvironment.hpp"
@@ -92,6 +93,24 @@ TEST_F(RunOutputTest, ParaViewSeriesHasOneFrameEveryFieldsEverySteps) {
       EXPECT_NE(text.find(name), std::string::npos) << xdmf << " does not reference " << name;
     }
   }
+}
+
+// The run ends with its profile by component, and the summary after it keeps full precision: D_xz printed as in
+// diagnostics.csv to six significant digits (the profile's one-decimal format must not leak into it).
+TEST_F(RunOutputTest, EndsWithTheProfileAndAFullPrecisionSummary) {
+  const std::string log = log_.str();
+  const auto profile = log.find("stepping took ");
+  ASSERT_NE(profile, std::string::npos) << log;
+  for (const char* part : {"membrane forces", "spreading", "fluid", "interpolation", "the rest"})
+    EXPECT_NE(log.find(part, profile), std::string::npos) << part;
+  const std::string key = "Taylor deformation D_xz = ";
+  const auto at = log.find(key, profile);
+  ASSERT_NE(at, std::string::npos) << log;
+  const double printed = std::stod(log.substr(at + key.size()));
+  const auto rows = read_csv(options_.out / "diagnostics.csv");
+  const double saved = std::stod(rows.back()[16]);  // D_xz
+  ASSERT_NE(saved, 0.0);
+  EXPECT_NEAR(printed, saved, 1e-5 * std::abs(saved));
 }
 
 TEST(RunOutput, WithoutFieldsNoParaViewFilesAndAPrefixPerMembrane) {

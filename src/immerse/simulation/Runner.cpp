@@ -384,9 +384,11 @@ int run_command(const RunOptions& options, std::ostream& out, std::ostream& err)
     if (const double wall = sim.op().min_wall_distance(); std::isfinite(wall))
       out << ", closest approach of a node to a wall " << wall;
   out << "\n";
-  if (done > 0)
-    out << std::fixed << std::setprecision(1) << "stepping took " << stepping << " s, "
-        << sim.op().timings().since(timings_at_start).profile(stepping, done) << std::defaultfloat << "\n";
+  if (done > 0) {
+    std::ostringstream took;  // its own stream: the precision set here must not reach the lines below
+    took << std::fixed << std::setprecision(1) << "stepping took " << stepping << " s, ";
+    out << took.str() << sim.op().timings().since(timings_at_start).profile(stepping, done) << "\n";
+  }
   for (std::size_t m = 0; m < sim.num_membranes(); ++m) {
     const auto X = sim.op().membrane_positions(m);
     const auto g = measure(sim.mesh(m), X);
