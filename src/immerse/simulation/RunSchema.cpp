@@ -109,6 +109,9 @@ ConfigSchema run_schema() {
   s.add_double("solver.gmres_rtol", 1e-3, Range::open(0, 1), "relative tolerance of each GMRES solve (§4: 1e-3)");
   s.add_int("solver.max_newton_its", 20, Range::at_least(1), "nonlinear iterations before a step is rejected and halved");
   s.add_int("solver.bfgs_memory", 20, Range::at_least(1), "stored pairs of the limited-memory quasi-Newton");
+  s.add_string("solver.initial_guess", "recurrence", {"recurrence", "extrapolation"},
+               "Newton's start: the linear extrapolation of §3 step 1 plus the error a recurrence fitted to the last "
+               "steps' errors predicts (recurrence), or the extrapolation alone (extrapolation, the paper's)");
   s.add_string("solver.petsc_options", "", {}, "extra PETSc options, e.g. \"-ksp_gmres_restart 50\"");
 
   s.add_int("output.diagnostics_every", 1, Range::at_least(1), "steps between rows of diagnostics.csv");

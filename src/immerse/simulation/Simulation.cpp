@@ -52,6 +52,9 @@ SolverSettings make_settings(const io::Config& c) {
   s.max_newton_its = c.get<int>("solver.max_newton_its");
   s.bfgs_memory = c.get<int>("solver.bfgs_memory");
   s.petsc_options = c.get<std::string>("solver.petsc_options");
+  s.initial_guess = c.get<std::string>("solver.initial_guess") == "extrapolation"
+                        ? SolverSettings::InitialGuess::Extrapolation
+                        : SolverSettings::InitialGuess::Recurrence;
   return s;
 }
 
@@ -304,6 +307,7 @@ io::Checkpoint Simulation::checkpoint() const {
   }
   ck.put_array("integrator.previous_positions", integrator_->previous_positions());
   ck.put_double("integrator.previous_dt", integrator_->previous_dt());
+  ck.put_array("integrator.guess_errors", integrator_->guess_errors().errors());
   ck.put_double("stepper.dt", stepper_.dt());
   ck.put_int("stepper.successes", stepper_.successes());
   return ck;
@@ -355,7 +359,10 @@ void Simulation::restore(const io::Checkpoint& ck) {
   std::vector<const ElasticMembrane*> ms;
   for (auto& m : membranes_) ms.push_back(m.get());
   op_ = std::make_unique<ImmersedBoundaryOperator>(fluid_, coupler_, ms, X, std::move(f));
-  integrator_->set_history(ck.array("integrator.previous_positions"), ck.get_double("integrator.previous_dt"));
+  // Checkpoints written before the initial-guess recurrence have no guess errors: it then starts afresh.
+  const std::string errors = "integrator.guess_errors";
+  integrator_->set_history(ck.array("integrator.previous_positions"), ck.get_double("integrator.previous_dt"),
+                           ck.has(errors) ? ck.array(errors) : std::vector<double>{});
   stepper_.set_state(ck.get_double("stepper.dt"), static_cast<int>(ck.get_int("stepper.successes")));
   step_ = ck.get_int("step");
 }

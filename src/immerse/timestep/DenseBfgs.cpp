@@ -35,7 +35,7 @@ StepStats DenseBfgs::step(CoupledOperator& op, double dt) {
   for (std::size_t i = 0; i < n; ++i) H_[i * n + i] = 1.0;
 
   try {
-    g.initial_guess(previous_positions(), previous_dt(), X_);
+    initial_guess(g, settings_.initial_guess, X_);
     g(X_, g_);
     for (int k = 0;; ++k) {
       stats.residual = std::sqrt(dot(g_, g_) / dot(X_, X_));
@@ -87,7 +87,7 @@ StepStats DenseBfgs::step(CoupledOperator& op, double dt) {
   }
   if (stats.converged) {
     if (!g.trial_matches(X_)) g(X_, g_);
-    remember(op, dt);
+    remember(op, dt, X_);
     op.commit(X_, dt);
   }
   stats.fluid_solves = op.fluid_solves() - solves0;

@@ -20,6 +20,35 @@ void SolverSettings::validate() const {
   require(bfgs_memory >= 1, "solver.bfgs_memory", bfgs_memory, "an integer >= 1");
 }
 
+void MembraneIntegrator::set_history(std::vector<double> previous_positions, double previous_dt,
+                                     std::span<const double> guess_errors) {
+  errors_.restore(guess_errors, previous_positions.size(), previous_dt);
+  prev_X_ = std::move(previous_positions);
+  prev_dt_ = previous_dt;
+}
+
+void MembraneIntegrator::initial_guess(const ThetaResidual& g, SolverSettings::InitialGuess initial_guess,
+                                       std::span<double> X0) {
+  g.initial_guess(prev_X_, prev_dt_, X0);
+  extrapolated_.clear();
+  if (initial_guess != SolverSettings::InitialGuess::Recurrence || prev_X_.size() != X0.size() || prev_dt_ <= 0)
+    return;
+  extrapolated_.assign(X0.begin(), X0.end());
+  errors_.predict(g.dt(), X0);
+}
+
+void MembraneIntegrator::remember(const CoupledOperator& op, double dt, std::span<const double> X) {
+  if (!extrapolated_.empty() && X.size() == extrapolated_.size()) {
+    for (std::size_t i = 0; i < X.size(); ++i) extrapolated_[i] = X[i] - extrapolated_[i];
+    errors_.record(dt, extrapolated_);
+  } else {
+    errors_.clear();
+  }
+  extrapolated_.clear();
+  prev_X_.assign(op.positions().begin(), op.positions().end());
+  prev_dt_ = dt;
+}
+
 const std::vector<std::string>& integrator_names() {
   static const std::vector<std::string> names{"euler", "rk2", "jfnk", "bfgs", "lbfgs"};
   return names;

@@ -1,22 +1,28 @@
 #pragma once
 // Advancing the membrane (paper §2.4): the schemes share this interface.
 #include <memory>
+#include <span>
 #include <string>
 #include <vector>
 
 #include "immerse/timestep/CoupledOperator.hpp"
+#include "immerse/timestep/ErrorRecurrence.hpp"
 #include "immerse/timestep/StepStats.hpp"
+#include "immerse/timestep/ThetaResidual.hpp"
 
 namespace immerse {
 
 /// Nonlinear-solver settings of the implicit schemes (§4: GMRES rtol 1e-3, Newton ||g||/||X|| < 1e-8).
 struct SolverSettings {
+  /// Newton's starting point: the linear extrapolation of §3 step 1, or that plus the error ErrorRecurrence predicts.
+  enum class InitialGuess { Extrapolation, Recurrence };
   double theta = 0.5;           ///< theta-method weight: 1/2 is the trapezoidal rule (29), 1 backward Euler
   double newton_rtol = 1e-8;    ///< stop when ||g|| / ||X|| < newton_rtol
   double gmres_rtol = 1e-3;     ///< relative tolerance of each GMRES solve
   int max_newton_its = 20;      ///< a step that needs more is rejected
   int bfgs_memory = 20;         ///< limited-memory quasi-Newton: stored pairs
   std::string petsc_options;    ///< extra PETSc options, e.g. "-ksp_gmres_restart 50"
+  InitialGuess initial_guess = InitialGuess::Recurrence;
   void validate() const;
 };
 
@@ -29,24 +35,27 @@ class MembraneIntegrator {
   virtual std::string name() const = 0;
 
   /// Positions X^{n-1} and step dt^{n-1} before the committed ones, used by the implicit schemes' initial guess
-  /// X^(0) = X^n + (dt/dt^{n-1})(X^n - X^{n-1}) (step 1 of §3); empty before the first step. Saved in checkpoints.
+  /// X^(0) = X^n + (dt/dt^{n-1})(X^n - X^{n-1}) (step 1 of §3); empty before the first step. Saved in checkpoints,
+  /// with the errors of the last extrapolations (ErrorRecurrence, all recorded with step dt^{n-1}).
   const std::vector<double>& previous_positions() const { return prev_X_; }
   double previous_dt() const { return prev_dt_; }
-  void set_history(std::vector<double> previous_positions, double previous_dt) {
-    prev_X_ = std::move(previous_positions);
-    prev_dt_ = previous_dt;
-  }
+  const ErrorRecurrence& guess_errors() const { return errors_; }
+  void set_history(std::vector<double> previous_positions, double previous_dt,
+                   std::span<const double> guess_errors = {});
 
  protected:
-  /// Records X^n as history just before the operator commits X^{n+1}.
-  void remember(const CoupledOperator& op, double dt) {
-    prev_X_.assign(op.positions().begin(), op.positions().end());
-    prev_dt_ = dt;
-  }
+  /// X^(0) of the implicit schemes: the linear extrapolation (ThetaResidual::initial_guess), plus the error
+  /// ErrorRecurrence predicts for it when `initial_guess` is Recurrence.
+  void initial_guess(const ThetaResidual& g, SolverSettings::InitialGuess initial_guess, std::span<double> X0);
+  /// Records X^n as history just before the operator commits X^{n+1} = X; an implicit scheme passes X, so that
+  /// the error of its extrapolated X^(0) is recorded.
+  void remember(const CoupledOperator& op, double dt, std::span<const double> X = {});
 
  private:
   std::vector<double> prev_X_;
   double prev_dt_ = 0;
+  std::vector<double> extrapolated_;  // this step's linear extrapolation; empty when X^(0) was not one
+  ErrorRecurrence errors_;
 };
 
 /// The schemes by name: "euler" (eq. 28), "rk2" (midpoint), "jfnk" (§2.4.3), "bfgs" (eq. 35, dense),

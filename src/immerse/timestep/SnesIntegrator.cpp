@@ -7,6 +7,12 @@
 #include "immerse/timestep/PetscSession.hpp"
 
 namespace immerse {
+namespace {
+
+// GMRES stops once the linearized residual is below this fraction of the Newton tolerance (header comment).
+constexpr double kGmresShareOfNewtonTolerance = 0.9;
+
+}  // namespace
 
 SnesIntegrator::SnesIntegrator(Method method, const SolverSettings& settings) : method_(method), settings_(settings) {
   settings_.validate();
@@ -133,17 +139,17 @@ StepStats SnesIntegrator::step(CoupledOperator& op, double dt) {
   IMMERSE_PETSC(VecGetArray(x_, &xs));
   {
     std::vector<double> X0(n_);
-    residual.initial_guess(previous_positions(), previous_dt(), X0);
+    initial_guess(residual, settings_.initial_guess, X0);
     for (std::size_t i = 0; i < n_; ++i) xs[i] = X0[i] / scale_;
   }
   IMMERSE_PETSC(VecRestoreArray(x_, &xs));
-  if (method_ == Method::NewtonKrylov && !user_atol_) {  // GMRES's absolute stop: half the Newton tolerance
+  if (method_ == Method::NewtonKrylov && !user_atol_) {  // GMRES's absolute stop: 0.9 of the Newton tolerance
     PetscReal xnorm;
     KSP ksp;
     IMMERSE_PETSC(VecNorm(x_, NORM_2, &xnorm));
     IMMERSE_PETSC(SNESGetKSP(snes_, &ksp));
-    IMMERSE_PETSC(KSPSetTolerances(ksp, PETSC_DEFAULT, 0.5 * settings_.newton_rtol * xnorm, PETSC_DEFAULT,
-                                   PETSC_DEFAULT));
+    const double atol = kGmresShareOfNewtonTolerance * settings_.newton_rtol * xnorm;
+    IMMERSE_PETSC(KSPSetTolerances(ksp, PETSC_DEFAULT, atol, PETSC_DEFAULT, PETSC_DEFAULT));
   }
 
   const PetscErrorCode ierr = SNESSolve(snes_, nullptr, x_);
@@ -179,7 +185,7 @@ StepStats SnesIntegrator::step(CoupledOperator& op, double dt) {
   IMMERSE_PETSC(VecRestoreArrayRead(x_, &xr));
   // The trial fluid state must be the one driven by the accepted positions.
   if (!residual.trial_matches(X_)) residual(X_, g_);
-  remember(op, dt);
+  remember(op, dt, X_);
   op.commit(X_, dt);
   stats.fluid_solves = op.fluid_solves() - solves0;
   return stats;

@@ -2,12 +2,14 @@
 // Implicit membrane update solved with PETSc SNES (paper §2.4.2-2.4.3, algorithm of §3):
 //
 //   solve g(X^{n+1}) = 0, g from eq. (31) (theta-method; theta = 1/2 is the trapezoidal rule (29)),
-//   starting from X^(0) = 2X^n - X^{n-1}, stopping when ||g|| / ||X|| < newton_rtol (§4: 1e-8).
+//   starting from X^(0) = 2X^n - X^{n-1} (step 1 of §3) plus the error ErrorRecurrence predicts for it,
+//   stopping when ||g|| / ||X|| < newton_rtol (§4: 1e-8).
 //
 // Method::NewtonKrylov ("jfnk", §2.4.3): Newton steps (33)-(34), each solved by unpreconditioned GMRES
 // (relative tolerance 1e-3, §4; it also stops once its residual, the linearized ||g|| after the step, is below
-// half the Newton tolerance, newton_rtol ||X^(0)|| / 2: a heuristic, the nonlinear and finite-difference terms
-// of the step are left the other half) whose matrix-vector product is the finite difference (36)
+// 0.9 newton_rtol ||X^(0)||: the Newton test is then met unless the nonlinear and finite-difference terms of the
+// step exceed a tenth of the tolerance; on §4.4 they are about 1 % of it) whose matrix-vector product is the
+// finite difference (36)
 //   J(X) y ~ (g(X + eps y) - g(X)) / eps,   eps = sqrt((1 + ||X||) eps_mach) / ||y||   (37),
 // which is PETSc's matrix-free Jacobian with the Walker-Pernice parameter (MATMFFD_WP). Full Newton steps.
 // Method::LimitedMemoryBFGS ("lbfgs"): PETSc's limited-memory quasi-Newton (SNESQN, LBFGS) with H_0 = I, the

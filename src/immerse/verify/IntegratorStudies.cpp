@@ -170,7 +170,7 @@ std::vector<Check> solver_agreement(bool quick) {
     auto jfnk = make_integrator("jfnk", s);
     exp.run_to(*jfnk, 2.0 / n, 1.0 / n);  // two identical JFNK steps first, so the third has history
     auto integ = make_integrator(scheme, s);
-    integ->set_history(jfnk->previous_positions(), jfnk->previous_dt());
+    integ->set_history(jfnk->previous_positions(), jfnk->previous_dt(), jfnk->guess_errors().errors());
     const auto st = integ->step(exp.op(), 1.0 / n);
     if (!st.converged) throw SimulationError(std::string(scheme) + " step failed: " + st.failure);
     its.push_back(st.newton_its);

@@ -1,0 +1,110 @@
+// The implicit step's initial guess: ErrorRecurrence on sequences with known recurrences, its history rules, and
+// its effect on JFNK (fewer fluid solves for the same steps).
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+#include <vector>
+
+#include "PetscEnvironment.hpp"
+#include "immerse/core/Error.hpp"
+#include "immerse/timestep/ErrorRecurrence.hpp"
+#include "immerse/verify/OscillatingMembrane.hpp"
+
+using namespace immerse;
+
+namespace {
+
+std::vector<double> random_vector(std::size_t n, unsigned seed) {
+  std::mt19937 gen(seed);
+  std::normal_distribution<double> N(0.0, 1.0);
+  std::vector<double> v(n);
+  for (auto& x : v) x = N(gen);
+  return v;
+}
+
+// e^k = r1^k v1 + r2^k v2: a soft mode decaying slowly and a stiff one ringing.
+std::vector<double> two_modes(int k, double r1, double r2) {
+  const auto v1 = random_vector(60, 1), v2 = random_vector(60, 2);
+  std::vector<double> e(60);
+  for (std::size_t i = 0; i < e.size(); ++i) e[i] = std::pow(r1, k) * v1[i] + std::pow(r2, k) * v2[i];
+  return e;
+}
+
+double relative_difference(const std::vector<double>& a, const std::vector<double>& b) {
+  double d = 0, n = 0;
+  for (std::size_t i = 0; i < a.size(); ++i) d += (a[i] - b[i]) * (a[i] - b[i]), n += b[i] * b[i];
+  return std::sqrt(d / n);
+}
+
+std::vector<double> prediction(const ErrorRecurrence& r, double dt, std::size_t n) {
+  std::vector<double> x(n, 0.0);
+  r.predict(dt, x);
+  return x;
+}
+
+}  // namespace
+
+TEST(ErrorRecurrence, PredictsARingingAndADecayingModeExactly) {
+  ErrorRecurrence r;
+  for (int k = 0; k < 3; ++k) r.record(0.1, two_modes(k, 0.9, -0.95));
+  EXPECT_EQ(r.terms(0.1), 2);
+  EXPECT_LT(relative_difference(prediction(r, 0.1, 60), two_modes(3, 0.9, -0.95)), 1e-12);
+  // The stored history slides: the next error is predicted from the last three.
+  r.record(0.1, two_modes(3, 0.9, -0.95));
+  EXPECT_LT(relative_difference(prediction(r, 0.1, 60), two_modes(4, 0.9, -0.95)), 1e-12);
+}
+
+TEST(ErrorRecurrence, UsesOneTermForASingleModeAndNoneForUnrelatedErrors) {
+  ErrorRecurrence one;
+  for (int k = 1; k <= 2; ++k) one.record(0.1, two_modes(k, -0.95, 0.0));  // (0^k = 0 for k >= 1: one mode)
+  EXPECT_EQ(one.terms(0.1), 1);
+  EXPECT_LT(relative_difference(prediction(one, 0.1, 60), two_modes(3, -0.95, 0.0)), 1e-12);
+  one.record(0.1, two_modes(3, -0.95, 0.0));  // three errors of one mode: the two-term fit is singular
+  EXPECT_EQ(one.terms(0.1), 1);
+  EXPECT_LT(relative_difference(prediction(one, 0.1, 60), two_modes(4, -0.95, 0.0)), 1e-12);
+
+  ErrorRecurrence none;
+  for (unsigned k = 0; k < 3; ++k) none.record(0.1, random_vector(60, 10 + k));
+  EXPECT_EQ(none.terms(0.1), 0);
+  for (double x : prediction(none, 0.1, 60)) EXPECT_EQ(x, 0.0);
+}
+
+TEST(ErrorRecurrence, ForgetsItsHistoryWhenTheStepChanges) {
+  ErrorRecurrence r;
+  for (int k = 0; k < 3; ++k) r.record(0.1, two_modes(k, 0.9, -0.95));
+  EXPECT_EQ(r.terms(0.05), 0);  // errors scale with dt: none predicted for another step
+  for (double x : prediction(r, 0.05, 60)) EXPECT_EQ(x, 0.0);
+  r.record(0.05, two_modes(0, 0.9, -0.95));
+  EXPECT_EQ(r.errors().size(), 60u);
+  EXPECT_EQ(r.terms(0.05), 0);
+}
+
+TEST(ErrorRecurrence, CheckpointRoundTripIsBitwise) {
+  ErrorRecurrence r, s;
+  for (int k = 0; k < 4; ++k) r.record(0.1, two_modes(k, 0.8, -0.97));
+  s.restore(r.errors(), 60, r.dt());
+  EXPECT_EQ(s.errors(), r.errors());
+  EXPECT_EQ(prediction(s, 0.1, 60), prediction(r, 0.1, 60));
+  EXPECT_THROW(s.restore(std::vector<double>(61, 1.0), 60, 0.1), InputError);
+  EXPECT_THROW(s.restore(std::vector<double>(240, 1.0), 60, 0.1), InputError);  // more than three errors
+}
+
+// §4.1's membrane, steps of dt = dx: the same positions (to the Newton tolerance) for fewer fluid solves.
+TEST(ErrorRecurrence, CutsTheFluidSolvesOfJfnkStepsWithoutChangingThem) {
+  std::vector<std::vector<double>> X;
+  std::vector<std::size_t> solves;
+  for (auto guess : {SolverSettings::InitialGuess::Extrapolation, SolverSettings::InitialGuess::Recurrence}) {
+    SolverSettings s;
+    s.initial_guess = guess;
+    verify::OscillatingMembrane exp(16, 2, 0.01);
+    auto jfnk = make_integrator("jfnk", s);
+    exp.run_to(*jfnk, 12.0 / 16, 1.0 / 16);
+    solves.push_back(exp.op().fluid_solves());
+    X.emplace_back(exp.op().positions().begin(), exp.op().positions().end());
+  }
+  std::cout << "12 JFNK steps: " << solves[0] << " fluid solves from the extrapolation, " << solves[1]
+            << " with the recurrence; positions differ by " << relative_difference(X[1], X[0]) << " (relative)\n";
+  EXPECT_LT(relative_difference(X[1], X[0]), 1e-7);
+  EXPECT_LT(solves[1], solves[0]);
+}
