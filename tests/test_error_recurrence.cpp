@@ -3,10 +3,12 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <iostream>
 #include <random>
 #include <vector>
 
 #include "PetscEnvironment.hpp"
+#include "ToyOperator.hpp"
 #include "immerse/core/Error.hpp"
 #include "immerse/timestep/ErrorRecurrence.hpp"
 #include "immerse/verify/OscillatingMembrane.hpp"
@@ -80,7 +82,7 @@ TEST(ErrorRecurrence, ForgetsItsHistoryWhenTheStepChanges) {
   EXPECT_EQ(r.terms(0.05), 0);
 }
 
-TEST(ErrorRecurrence, CheckpointRoundTripIsBitwise) {
+TEST(ErrorRecurrence, RestoreOfItsErrorsIsBitwise) {
   ErrorRecurrence r, s;
   for (int k = 0; k < 4; ++k) r.record(0.1, two_modes(k, 0.8, -0.97));
   s.restore(r.errors(), 60, r.dt());
@@ -88,6 +90,27 @@ TEST(ErrorRecurrence, CheckpointRoundTripIsBitwise) {
   EXPECT_EQ(prediction(s, 0.1, 60), prediction(r, 0.1, 60));
   EXPECT_THROW(s.restore(std::vector<double>(61, 1.0), 60, 0.1), InputError);
   EXPECT_THROW(s.restore(std::vector<double>(240, 1.0), 60, 0.1), InputError);  // more than three errors
+}
+
+// The integrators keep the errors of extrapolated guesses over equal steps only: none after the first step (its
+// guess is X^n + dt U^n), none across a change of step, none for an explicit scheme; at most three.
+TEST(ErrorRecurrence, IntegratorsKeepTheErrorsOfEqualExtrapolatedStepsOnly) {
+  auto stored = [](const MembraneIntegrator& m) { return m.guess_errors().errors().size() / 3; };
+  immerse::testing::ToyOperator op({1.1, 2.0, 3.0}, {1.0, 2.0, 3.0}, 1e4, 0.5, 1.0);
+  auto jfnk = make_integrator("jfnk", {});
+  for (std::size_t expected : {0, 1, 2, 3, 3}) {
+    ASSERT_TRUE(jfnk->step(op, 0.05).converged);
+    EXPECT_EQ(stored(*jfnk), expected);
+  }
+  ASSERT_TRUE(jfnk->step(op, 0.025).converged);
+  EXPECT_EQ(stored(*jfnk), 0u);
+  ASSERT_TRUE(jfnk->step(op, 0.025).converged);
+  EXPECT_EQ(stored(*jfnk), 1u);
+
+  immerse::testing::ToyOperator op2({1.1, 2.0, 3.0}, {1.0, 2.0, 3.0}, 40, 0.5, 1.0);
+  auto rk2 = make_integrator("rk2", {});
+  for (int i = 0; i < 4; ++i) rk2->step(op2, 0.01);
+  EXPECT_EQ(stored(*rk2), 0u);
 }
 
 // §4.1's membrane, steps of dt = dx: the same positions (to the Newton tolerance) for fewer fluid solves.

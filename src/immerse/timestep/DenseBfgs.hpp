@@ -5,7 +5,8 @@
 //   X^(k+1) = X^(k) - H_k g^(k),   p_k = X^(k+1) - X^(k),   q_k = g^(k+1) - g^(k),
 //   H_{k+1} = H_k + (1 + q^T H q / p^T q) p p^T / p^T q - (p q^T H + H q p^T) / p^T q,
 //
-// starting each step from H_0 = I (J = I - (dt/2) u' of eq. (32) is close to I) and X^(0) = 2X^n - X^{n-1}.
+// starting each step from H_0 = I (J = I - (dt/2) u' of eq. (32) is close to I) and the X^(0) of the other
+// implicit schemes (MembraneIntegrator::initial_guess: 2X^n - X^{n-1}, corrected by ErrorRecurrence by default).
 // H is n x n (n = 3 x nodes): §2.4.2 explains why this cannot run on the 3D meshes of §4; use "lbfgs" there.
 #include "immerse/timestep/MembraneIntegrator.hpp"
 

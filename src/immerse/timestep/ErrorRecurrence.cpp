@@ -31,7 +31,7 @@ ErrorRecurrence::Fit ErrorRecurrence::fit() const {
     const auto& q = e_[m - 3];
     const double qq = dot(q, q), pq = dot(p, q), yq = dot(y, q);
     const double det = pp * qq - pq * pq;
-    if (det > 1e-12 * pp * qq) {
+    if (det > 1e-8 * pp * qq) {
       const double a1 = (yp * qq - yq * pq) / det, a2 = (yq * pp - yp * pq) / det;
       if (const double res = yy - a1 * yp - a2 * yq; res < best_res) best = {2, a1, a2};
     }
@@ -72,12 +72,11 @@ std::vector<double> ErrorRecurrence::errors() const {
 }
 
 void ErrorRecurrence::restore(std::span<const double> errors, std::size_t n, double dt) {
-  clear();
-  if (errors.empty()) return;
-  if (n == 0 || errors.size() % n != 0 || errors.size() / n > kDepth)
+  if (!errors.empty() && (n == 0 || errors.size() % n != 0 || errors.size() / n > kDepth))
     throw InputError("checkpoint: integrator.guess_errors holds " + std::to_string(errors.size()) +
                      " values, not up to " + std::to_string(kDepth) + " vectors of " + std::to_string(n));
-  for (std::size_t k = 0; k < errors.size() / n; ++k) record(dt, errors.subspan(k * n, n));
+  clear();
+  for (std::size_t k = 0; !errors.empty() && k < errors.size() / n; ++k) record(dt, errors.subspan(k * n, n));
 }
 
 }  // namespace immerse

@@ -9,13 +9,13 @@
 //   e^{k} = a1 e^{k-1} + a2 e^{k-2}    (a1 = r1 + r2, a2 = -r1 r2).
 //
 // The coefficients are fitted by least squares to the last three errors (e^n on e^{n-1}, e^{n-2}; one term when
-// only two are known, or when it fits better) and the next error is predicted,
+// only two are known or the two-term fit is singular) and the next error is predicted,
 //
 //   X^(0) = X_e^{n+1} + a1 e^n + a2 e^{n-1}.
 //
 // The prediction is skipped when the fit explains less than three quarters of e^n (relative residual above 1/2),
-// and the history is dropped when dt changes (the errors scale with it). Measured on §4.4 (docs/performance.md):
-// the predicted error is 3 % of e^{n+1} with the paper's cells, 12-17 % with 100x stiffer ones.
+// and the history is dropped when dt changes (the errors scale with it). Measured on §4.4 (docs/time-integration.md):
+// the prediction misses e^{n+1} by 2-3 % with the paper's cells, by 12-17 % with 100x stiffer ones.
 #include <cstddef>
 #include <deque>
 #include <span>

@@ -31,7 +31,8 @@ void MembraneIntegrator::initial_guess(const ThetaResidual& g, SolverSettings::I
                                        std::span<double> X0) {
   g.initial_guess(prev_X_, prev_dt_, X0);
   extrapolated_.clear();
-  if (initial_guess != SolverSettings::InitialGuess::Recurrence || prev_X_.size() != X0.size() || prev_dt_ <= 0)
+  // Only an extrapolation over a step equal to the last one is recorded: the errors scale with the steps.
+  if (initial_guess != SolverSettings::InitialGuess::Recurrence || prev_X_.size() != X0.size() || prev_dt_ != g.dt())
     return;
   extrapolated_.assign(X0.begin(), X0.end());
   errors_.predict(g.dt(), X0);

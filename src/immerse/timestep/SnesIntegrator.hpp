@@ -2,7 +2,8 @@
 // Implicit membrane update solved with PETSc SNES (paper §2.4.2-2.4.3, algorithm of §3):
 //
 //   solve g(X^{n+1}) = 0, g from eq. (31) (theta-method; theta = 1/2 is the trapezoidal rule (29)),
-//   starting from X^(0) = 2X^n - X^{n-1} (step 1 of §3) plus the error ErrorRecurrence predicts for it,
+//   starting from X^(0) = 2X^n - X^{n-1} (step 1 of §3), plus the error ErrorRecurrence predicts for it when
+//   solver.initial_guess = "recurrence" (the default),
 //   stopping when ||g|| / ||X|| < newton_rtol (§4: 1e-8).
 //
 // Method::NewtonKrylov ("jfnk", §2.4.3): Newton steps (33)-(34), each solved by unpreconditioned GMRES
@@ -60,7 +61,7 @@ class SnesIntegrator final : public MembraneIntegrator {
   std::vector<double> X_, g_;
   std::exception_ptr callback_error_;
   double last_ratio_ = 0;
-  // -ksp_atol given in petsc_options: it replaces the stop at half the Newton tolerance.
+  // -ksp_atol given in petsc_options: it replaces the stop at 0.9 of the Newton tolerance.
   PetscBool user_atol_ = PETSC_FALSE;
 };
 
