@@ -21,7 +21,7 @@ ErrorRecurrence::Fit ErrorRecurrence::fit() const {
   const auto& p = e_[m - 2];  // on e^{n-1}
   const double yy = dot(y, y), yp = dot(y, p), pp = dot(p, p);
   if (yy == 0 || pp == 0) return best;
-  double best_res = 0.25 * yy;  // squared residual to beat: half of ||e^n||
+  double best_res = 0.25 * yy;  // squared residual to beat: a relative residual of 1/2
   // One term: y ~ a1 p; residual^2 = yy - a1 yp.
   if (const double a1 = yp / pp, res = yy - a1 * yp; res < best_res) {
     best = {1, a1, 0};

@@ -27,12 +27,12 @@ void MembraneIntegrator::set_history(std::vector<double> previous_positions, dou
   prev_dt_ = previous_dt;
 }
 
-void MembraneIntegrator::initial_guess(const ThetaResidual& g, SolverSettings::InitialGuess initial_guess,
+void MembraneIntegrator::initial_guess(const ThetaResidual& g, SolverSettings::InitialGuess guess,
                                        std::span<double> X0) {
   g.initial_guess(prev_X_, prev_dt_, X0);
   extrapolated_.clear();
   // Only an extrapolation over a step equal to the last one is recorded: the errors scale with the steps.
-  if (initial_guess != SolverSettings::InitialGuess::Recurrence || prev_X_.size() != X0.size() || prev_dt_ != g.dt())
+  if (guess != SolverSettings::InitialGuess::Recurrence || prev_X_.size() != X0.size() || prev_dt_ != g.dt())
     return;
   extrapolated_.assign(X0.begin(), X0.end());
   errors_.predict(g.dt(), X0);

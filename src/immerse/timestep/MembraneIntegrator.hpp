@@ -45,8 +45,8 @@ class MembraneIntegrator {
 
  protected:
   /// X^(0) of the implicit schemes: the linear extrapolation (ThetaResidual::initial_guess), plus the error
-  /// ErrorRecurrence predicts for it when `initial_guess` is Recurrence.
-  void initial_guess(const ThetaResidual& g, SolverSettings::InitialGuess initial_guess, std::span<double> X0);
+  /// ErrorRecurrence predicts for it when `guess` is Recurrence.
+  void initial_guess(const ThetaResidual& g, SolverSettings::InitialGuess guess, std::span<double> X0);
   /// Records X^n as history just before the operator commits X^{n+1} = X; an implicit scheme passes X, so that
   /// the error of its extrapolated X^(0) is recorded.
   void remember(const CoupledOperator& op, double dt, std::span<const double> X = {});
