@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <iostream>
+#include <numeric>
 #include <random>
 #include <vector>
 
@@ -72,6 +73,21 @@ TEST(ErrorRecurrence, UsesOneTermForASingleModeAndNoneForUnrelatedErrors) {
   for (double x : prediction(none, 0.1, 60)) EXPECT_EQ(x, 0.0);
 }
 
+TEST(ErrorRecurrence, StopsPredictingWhenItsLastPredictionMissedByMoreThanTheError) {
+  ErrorRecurrence r;
+  for (int k = 0; k < 3; ++k) r.record(0.1, two_modes(k, 0.9, -0.95));
+  ASSERT_EQ(r.terms(0.1), 2);
+  // The recurrence stops holding: e^3 unrelated to the prediction two_modes(3), and of the same size.
+  const auto predicted = two_modes(3, 0.9, -0.95);
+  auto e3 = random_vector(60, 7);
+  const double scale = std::sqrt(std::inner_product(predicted.begin(), predicted.end(), predicted.begin(), 0.0) /
+                                 std::inner_product(e3.begin(), e3.end(), e3.begin(), 0.0));
+  for (auto& x : e3) x *= scale;
+  r.record(0.1, e3);
+  EXPECT_EQ(r.terms(0.1), 0);
+  for (double x : prediction(r, 0.1, 60)) EXPECT_EQ(x, 0.0);
+}
+
 TEST(ErrorRecurrence, ForgetsItsHistoryWhenTheStepChanges) {
   ErrorRecurrence r;
   for (int k = 0; k < 3; ++k) r.record(0.1, two_modes(k, 0.9, -0.95));
@@ -89,16 +105,16 @@ TEST(ErrorRecurrence, RestoreOfItsErrorsIsBitwise) {
   EXPECT_EQ(s.errors(), r.errors());
   EXPECT_EQ(prediction(s, 0.1, 60), prediction(r, 0.1, 60));
   EXPECT_THROW(s.restore(std::vector<double>(61, 1.0), 60, 0.1), InputError);
-  EXPECT_THROW(s.restore(std::vector<double>(240, 1.0), 60, 0.1), InputError);  // more than three errors
+  EXPECT_THROW(s.restore(std::vector<double>(300, 1.0), 60, 0.1), InputError);  // more than four errors
 }
 
 // The integrators keep the errors of extrapolated guesses over equal steps only: none after the first step (its
-// guess is X^n + dt U^n), none across a change of step, none for an explicit scheme; at most three.
+// guess is X^n + dt U^n), none across a change of step, none for an explicit scheme; at most four.
 TEST(ErrorRecurrence, IntegratorsKeepTheErrorsOfEqualExtrapolatedStepsOnly) {
   auto stored = [](const MembraneIntegrator& m) { return m.guess_errors().errors().size() / 3; };
   immerse::testing::ToyOperator op({1.1, 2.0, 3.0}, {1.0, 2.0, 3.0}, 1e4, 0.5, 1.0);
   auto jfnk = make_integrator("jfnk", {});
-  for (std::size_t expected : {0, 1, 2, 3, 3}) {
+  for (std::size_t expected : {0, 1, 2, 3, 4, 4}) {
     ASSERT_TRUE(jfnk->step(op, 0.05).converged);
     EXPECT_EQ(stored(*jfnk), expected);
   }

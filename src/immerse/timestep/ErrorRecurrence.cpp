@@ -13,9 +13,9 @@ double dot(const std::vector<double>& a, const std::vector<double>& b) {
 
 }  // namespace
 
-ErrorRecurrence::Fit ErrorRecurrence::fit() const {
+ErrorRecurrence::Fit ErrorRecurrence::fit(std::size_t end) const {
   Fit best;
-  const std::size_t m = e_.size();
+  const std::size_t m = end;
   if (m < 2) return best;
   const auto& y = e_[m - 1];  // fitted: e^n
   const auto& p = e_[m - 2];  // on e^{n-1}
@@ -27,7 +27,7 @@ ErrorRecurrence::Fit ErrorRecurrence::fit() const {
     best = {1, a1, 0};
     best_res = res;
   }
-  if (m >= 3) {  // two terms: y ~ a1 p + a2 q, normal equations
+  if (m >= 3) {  // two terms: y ~ a1 p + a2 q, normal equations (only the last three errors)
     const auto& q = e_[m - 3];
     const double qq = dot(q, q), pq = dot(p, q), yq = dot(y, q);
     const double det = pp * qq - pq * pq;
@@ -39,11 +39,29 @@ ErrorRecurrence::Fit ErrorRecurrence::fit() const {
   return best;
 }
 
-int ErrorRecurrence::terms(double dt) const { return dt == dt_ ? fit().terms : 0; }
+ErrorRecurrence::Fit ErrorRecurrence::next_fit() const {
+  const std::size_t m = e_.size();
+  if (m >= 3) {  // did the last prediction, e^n ~ a1 e^{n-1} + a2 e^{n-2} from the fit one step earlier, help?
+    const Fit last = fit(m - 1);
+    if (last.terms > 0) {
+      const auto& y = e_[m - 1];
+      double miss = 0, yy = 0;
+      for (std::size_t i = 0; i < y.size(); ++i) {
+        const double pred = last.a1 * e_[m - 2][i] + (last.terms == 2 ? last.a2 * e_[m - 3][i] : 0.0);
+        miss += (y[i] - pred) * (y[i] - pred);
+        yy += y[i] * y[i];
+      }
+      if (miss > yy) return {};
+    }
+  }
+  return fit(m);
+}
+
+int ErrorRecurrence::terms(double dt) const { return dt == dt_ ? next_fit().terms : 0; }
 
 void ErrorRecurrence::predict(double dt, std::span<double> X) const {
   if (dt != dt_) return;
-  const Fit f = fit();
+  const Fit f = next_fit();
   if (f.terms == 0) return;
   const std::size_t m = e_.size();
   const auto& en = e_[m - 1];

@@ -14,7 +14,9 @@
 //   X^(0) = X_e^{n+1} + a1 e^n + a2 e^{n-1}.
 //
 // The prediction is skipped when the fit explains less than three quarters of e^n (relative residual above 1/2),
-// and the history is dropped when dt changes (the errors scale with it). Measured on §4.4 (docs/time-integration.md):
+// or when the last prediction (the same fit one step earlier, recomputed from the stored errors) missed e^n by more
+// than e^n itself (the recurrence stopped holding: the extrapolation alone was better). The history is dropped
+// when dt changes (the errors scale with it). Measured on §4.4 (docs/time-integration.md):
 // the prediction misses e^{n+1} by 2-3 % with the paper's cells, by 12-17 % with 100x stiffer ones.
 #include <cstddef>
 #include <deque>
@@ -44,8 +46,11 @@ class ErrorRecurrence {
     int terms = 0;
     double a1 = 0, a2 = 0;
   };
-  Fit fit() const;
-  static constexpr std::size_t kDepth = 3;
+  // The fit of e_[end-1] on e_[end-2] (and e_[end-3]): the one that predicted e_[end].
+  Fit fit(std::size_t end) const;
+  Fit next_fit() const;
+  // Four errors: the last three for the next prediction, and one more to recompute the last prediction.
+  static constexpr std::size_t kDepth = 4;
   std::deque<std::vector<double>> e_;
   double dt_ = 0;
 };
