@@ -13,9 +13,8 @@ double dot(const std::vector<double>& a, const std::vector<double>& b) {
 
 }  // namespace
 
-ErrorRecurrence::Fit ErrorRecurrence::fit(std::size_t end) const {
+ErrorRecurrence::Fit ErrorRecurrence::fit(std::size_t m) const {
   Fit best;
-  const std::size_t m = end;
   if (m < 2) return best;
   const auto& y = e_[m - 1];  // fitted: e^n
   const auto& p = e_[m - 2];  // on e^{n-1}
@@ -27,7 +26,7 @@ ErrorRecurrence::Fit ErrorRecurrence::fit(std::size_t end) const {
     best = {1, a1, 0};
     best_res = res;
   }
-  if (m >= 3) {  // two terms: y ~ a1 p + a2 q, normal equations (only the last three errors)
+  if (m >= 3) {  // two terms: y ~ a1 p + a2 q, normal equations
     const auto& q = e_[m - 3];
     const double qq = dot(q, q), pq = dot(p, q), yq = dot(y, q);
     const double det = pp * qq - pq * pq;

@@ -46,8 +46,8 @@ class ErrorRecurrence {
     int terms = 0;
     double a1 = 0, a2 = 0;
   };
-  // The fit of e_[end-1] on e_[end-2] (and e_[end-3]): the one that predicted e_[end].
-  Fit fit(std::size_t end) const;
+  // The fit of e_[m-1] on e_[m-2] (and e_[m-3]), which predicts e_[m].
+  Fit fit(std::size_t m) const;
   Fit next_fit() const;
   // Four errors: the last three for the next prediction, and one more to recompute the last prediction.
   static constexpr std::size_t kDepth = 4;
