@@ -1,11 +1,14 @@
 // The implicit step's initial guess: ErrorRecurrence on sequences with known recurrences, its history rules, and
 // its effect on JFNK (fewer fluid solves for the same steps).
 #include <gtest/gtest.h>
+#include <omp.h>
 
 #include <cmath>
 #include <iostream>
 #include <numeric>
 #include <random>
+#include <span>
+#include <stdexcept>
 #include <vector>
 
 #include "PetscEnvironment.hpp"
@@ -40,10 +43,21 @@ double relative_difference(const std::vector<double>& a, const std::vector<doubl
   return std::sqrt(d / n);
 }
 
-std::vector<double> prediction(const ErrorRecurrence& r, double dt, std::size_t n) {
+std::vector<double> prediction(const ErrorRecurrence& r, double dt, std::size_t n,
+                               std::span<const std::size_t> offsets = {}) {
   std::vector<double> x(n, 0.0);
-  r.predict(dt, x);
+  r.predict(dt, x, offsets);
   return x;
+}
+
+// e^k = sum_j r_j^k v_j over the modes r (random v_j of length n).
+std::vector<double> modes(int k, const std::vector<double>& r, std::size_t n, unsigned seed) {
+  std::vector<double> e(n, 0.0);
+  for (std::size_t j = 0; j < r.size(); ++j) {
+    const auto v = random_vector(n, seed + static_cast<unsigned>(j));
+    for (std::size_t i = 0; i < n; ++i) e[i] += std::pow(r[j], k) * v[i];
+  }
+  return e;
 }
 
 }  // namespace
@@ -71,6 +85,46 @@ TEST(ErrorRecurrence, UsesOneTermForASingleModeAndNoneForUnrelatedErrors) {
   for (unsigned k = 0; k < 3; ++k) none.record(0.1, random_vector(60, 10 + k));
   EXPECT_EQ(none.terms(0.1), 0);
   for (double x : prediction(none, 0.1, 60)) EXPECT_EQ(x, 0.0);
+}
+
+TEST(ErrorRecurrence, FitsUpToFiveTermsToTheLastTwoErrors) {
+  const std::vector<double> r{0.95, 0.6, 0.1, -0.7, -0.97};
+  ErrorRecurrence rec;
+  for (int k = 0; k < 7; ++k) rec.record(0.1, modes(k, r, 200, 20));
+  EXPECT_EQ(rec.terms(0.1), 5);
+  EXPECT_LT(relative_difference(prediction(rec, 0.1, 200), modes(7, r, 200, 20)), 1e-8);
+}
+
+// Two membranes with three modes each: one recurrence for all would need six terms; one per block is exact.
+TEST(ErrorRecurrence, FitsEachBlockItsOwnRecurrence) {
+  const std::vector<double> ra{0.9, 0.3, -0.95}, rb{0.7, -0.2, -0.8};
+  auto both = [&](int k) {
+    auto e = modes(k, ra, 150, 30);
+    const auto b = modes(k, rb, 90, 40);
+    e.insert(e.end(), b.begin(), b.end());
+    return e;
+  };
+  const std::vector<std::size_t> offsets{0, 150, 240};
+  ErrorRecurrence rec;
+  for (int k = 0; k < 7; ++k) rec.record(0.1, both(k));
+  EXPECT_EQ(rec.terms(0.1, offsets), 3);
+  EXPECT_LT(relative_difference(prediction(rec, 0.1, 240, offsets), both(7)), 1e-8);
+  EXPECT_GT(relative_difference(prediction(rec, 0.1, 240), both(7)), 1e-4);
+  std::vector<double> X(240);
+  EXPECT_THROW(rec.predict(0.1, X, std::vector<std::size_t>{0, 150}), std::logic_error);
+}
+
+TEST(ErrorRecurrence, PredictionDoesNotDependOnTheNumberOfThreads) {
+  const std::vector<std::size_t> offsets{0, 300, 600, 900, 1200};
+  ErrorRecurrence rec;
+  for (int k = 0; k < 8; ++k) rec.record(0.1, modes(k, {0.9, 0.5, -0.3, -0.9}, 1200, 50));
+  const int threads = omp_get_max_threads();
+  omp_set_num_threads(1);
+  const auto one = prediction(rec, 0.1, 1200, offsets);
+  omp_set_num_threads(2);
+  const auto two = prediction(rec, 0.1, 1200, offsets);
+  omp_set_num_threads(threads);
+  EXPECT_EQ(one, two);
 }
 
 TEST(ErrorRecurrence, StopsPredictingWhenItsLastPredictionMissedByMoreThanTheError) {
@@ -105,16 +159,16 @@ TEST(ErrorRecurrence, RestoreOfItsErrorsIsBitwise) {
   EXPECT_EQ(s.errors(), r.errors());
   EXPECT_EQ(prediction(s, 0.1, 60), prediction(r, 0.1, 60));
   EXPECT_THROW(s.restore(std::vector<double>(61, 1.0), 60, 0.1), InputError);
-  EXPECT_THROW(s.restore(std::vector<double>(300, 1.0), 60, 0.1), InputError);  // more than four errors
+  EXPECT_THROW(s.restore(std::vector<double>(540, 1.0), 60, 0.1), InputError);  // more than eight errors
 }
 
 // The integrators keep the errors of extrapolated guesses over equal steps only: none after the first step (its
-// guess is X^n + dt U^n), none across a change of step, none for an explicit scheme; at most four.
+// guess is X^n + dt U^n), none across a change of step, none for an explicit scheme; at most eight.
 TEST(ErrorRecurrence, IntegratorsKeepTheErrorsOfEqualExtrapolatedStepsOnly) {
   auto stored = [](const MembraneIntegrator& m) { return m.guess_errors().errors().size() / 3; };
   immerse::testing::ToyOperator op({1.1, 2.0, 3.0}, {1.0, 2.0, 3.0}, 1e4, 0.5, 1.0);
   auto jfnk = make_integrator("jfnk", {});
-  for (std::size_t expected : {0, 1, 2, 3, 4, 4}) {
+  for (std::size_t expected : {0, 1, 2, 3, 4, 5, 6, 7, 8, 8}) {
     ASSERT_TRUE(jfnk->step(op, 0.05).converged);
     EXPECT_EQ(stored(*jfnk), expected);
   }

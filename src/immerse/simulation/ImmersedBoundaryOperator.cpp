@@ -138,6 +138,12 @@ void ImmersedBoundaryOperator::commit(std::span<const double> X, double) {
   trial_X_.clear();
 }
 
+std::vector<std::size_t> ImmersedBoundaryOperator::membrane_offsets() const {
+  std::vector<std::size_t> o(offset_.size());
+  std::ranges::transform(offset_, o.begin(), [](std::size_t node) { return 3 * node; });
+  return o;
+}
+
 std::vector<Vec3> ImmersedBoundaryOperator::membrane_positions(std::size_t m) const {
   return {X_.begin() + static_cast<std::ptrdiff_t>(offset_[m]), X_.begin() + static_cast<std::ptrdiff_t>(offset_[m + 1])};
 }

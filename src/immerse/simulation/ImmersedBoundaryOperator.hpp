@@ -32,6 +32,7 @@ class ImmersedBoundaryOperator final : public CoupledOperator {
   std::size_t size() const override { return 3 * X_.size(); }
   std::span<const double> positions() const override { return flat(X_); }
   std::span<const double> node_velocity() const override { return flat(U_); }
+  std::vector<std::size_t> membrane_offsets() const override;
   double length_scale() const override { return fluid_.grid().h(); }
   void trial_velocity(std::span<const double> Xf, double theta, std::span<const double> Xi, double dt,
                       std::span<double> U) override;

@@ -7,6 +7,7 @@
 // The integrators see nothing of grids: only positions, node velocities, and one fluid step as a function.
 #include <cstddef>
 #include <span>
+#include <vector>
 
 namespace immerse {
 
@@ -20,6 +21,8 @@ class CoupledOperator {
   virtual std::span<const double> positions() const = 0;
   /// Committed node velocity U^n = J(X^n) u^n.
   virtual std::span<const double> node_velocity() const = 0;
+  /// Where each membrane's unknowns begin in X, then size(): membrane m holds [offsets[m], offsets[m+1]).
+  virtual std::vector<std::size_t> membrane_offsets() const { return {0, size()}; }
   /// Length scale of the problem (e.g. the grid spacing); the solvers measure positions in it.
   virtual double length_scale() const = 0;
 

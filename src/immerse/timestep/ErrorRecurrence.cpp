@@ -1,73 +1,125 @@
 #include "immerse/timestep/ErrorRecurrence.hpp"
 
-#include <numeric>
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+#include <string>
 
 #include "immerse/core/Error.hpp"
 
 namespace immerse {
-namespace {
 
-double dot(const std::vector<double>& a, const std::vector<double>& b) {
-  return std::inner_product(a.begin(), a.end(), b.begin(), 0.0);
-}
-
-}  // namespace
-
-ErrorRecurrence::Fit ErrorRecurrence::fit(std::size_t m) const {
-  Fit best;
-  if (m < 2) return best;
-  const auto& y = e_[m - 1];  // fitted: e^n
-  const auto& p = e_[m - 2];  // on e^{n-1}
-  const double yy = dot(y, y), yp = dot(y, p), pp = dot(p, p);
-  if (yy == 0 || pp == 0) return best;
-  double best_res = 0.25 * yy;  // squared residual to beat: a relative residual of 1/2
-  // One term: y ~ a1 p; residual^2 = yy - a1 yp.
-  if (const double a1 = yp / pp, res = yy - a1 * yp; res < best_res) {
-    best = {1, a1, 0};
-    best_res = res;
-  }
-  if (m >= 3) {  // two terms: y ~ a1 p + a2 q, normal equations
-    const auto& q = e_[m - 3];
-    const double qq = dot(q, q), pq = dot(p, q), yq = dot(y, q);
-    const double det = pp * qq - pq * pq;
-    if (det > 1e-8 * pp * qq) {
-      const double a1 = (yp * qq - yq * pq) / det, a2 = (yq * pp - yp * pq) / det;
-      if (const double res = yy - a1 * yp - a2 * yq; res < best_res) best = {2, a1, a2};
-    }
-  }
-  return best;
-}
-
-ErrorRecurrence::Fit ErrorRecurrence::next_fit() const {
+ErrorRecurrence::Gram ErrorRecurrence::gram(std::size_t begin, std::size_t end) const {
+  Gram G{};
   const std::size_t m = e_.size();
-  if (m >= 3) {  // did the last prediction, e^n ~ a1 e^{n-1} + a2 e^{n-2} from the fit one step earlier, help?
-    const Fit last = fit(m - 1);
-    if (last.terms > 0) {
-      const auto& y = e_[m - 1];
-      double miss = 0, yy = 0;
-      for (std::size_t i = 0; i < y.size(); ++i) {
-        const double pred = last.a1 * e_[m - 2][i] + (last.terms == 2 ? last.a2 * e_[m - 3][i] : 0.0);
-        miss += (y[i] - pred) * (y[i] - pred);
-        yy += y[i] * y[i];
+  std::array<const double*, kDepth> e{};
+  for (std::size_t i = 0; i < m; ++i) e[i] = e_[i].data();
+  for (std::size_t k = begin; k < end; ++k)  // one pass over the block, each sum in the order of k
+    for (std::size_t i = 0; i < m; ++i)
+      for (std::size_t j = 0; j <= i; ++j) G[i][j] += e[i][k] * e[j][k];
+  for (std::size_t i = 0; i < m; ++i)
+    for (std::size_t j = 0; j < i; ++j) G[j][i] = G[i][j];
+  return G;
+}
+
+ErrorRecurrence::Fit ErrorRecurrence::fit(const Gram& G, std::size_t m) {
+  if (m < 2) return {};
+  for (int t = static_cast<int>(std::min<std::size_t>(kMaxTerms, m - 1)); t >= 1; --t) {
+    // Normal equations of e_[j] ~ sum_p a_p e_[j-1-p] over the targets j = m-w .. m-1.
+    const std::size_t w = std::min<std::size_t>(kWindow, m - static_cast<std::size_t>(t));
+    std::array<std::array<double, kMaxTerms>, kMaxTerms> N{};
+    std::array<double, kMaxTerms> b{};
+    double yy = 0;
+    for (std::size_t j = m - w; j < m; ++j) {
+      yy += G[j][j];
+      for (int p = 0; p < t; ++p) {
+        b[p] += G[j][j - 1 - p];
+        for (int q = 0; q < t; ++q) N[p][q] += G[j - 1 - p][j - 1 - q];
       }
-      if (miss > yy) return {};
     }
+    if (yy == 0) return {};
+    // Cholesky N = L L^T; a pivot below 1e-8 of its diagonal entry means the errors are dependent: a term less.
+    std::array<std::array<double, kMaxTerms>, kMaxTerms> L{};
+    bool singular = false;
+    for (int k = 0; k < t && !singular; ++k) {
+      double d = N[k][k];
+      for (int j = 0; j < k; ++j) d -= L[k][j] * L[k][j];
+      if (!(d > 1e-8 * N[k][k])) {
+        singular = true;
+        break;
+      }
+      L[k][k] = std::sqrt(d);
+      for (int i = k + 1; i < t; ++i) {
+        double s = N[i][k];
+        for (int j = 0; j < k; ++j) s -= L[i][j] * L[k][j];
+        L[i][k] = s / L[k][k];
+      }
+    }
+    if (singular) continue;
+    Fit f;
+    f.terms = t;
+    std::array<double, kMaxTerms> z{};
+    for (int i = 0; i < t; ++i) {
+      double s = b[i];
+      for (int j = 0; j < i; ++j) s -= L[i][j] * z[j];
+      z[i] = s / L[i][i];
+    }
+    for (int i = t - 1; i >= 0; --i) {
+      double s = z[i];
+      for (int j = i + 1; j < t; ++j) s -= L[j][i] * f.a[j];
+      f.a[i] = s / L[i][i];
+    }
+    double res = yy;  // squared residual of the fit
+    for (int p = 0; p < t; ++p) res -= f.a[p] * b[p];
+    return res < 0.25 * yy ? f : Fit{};  // relative residual below 1/2
   }
-  return fit(m);
+  return {};
 }
 
-int ErrorRecurrence::terms(double dt) const { return dt == dt_ ? next_fit().terms : 0; }
-
-void ErrorRecurrence::predict(double dt, std::span<double> X) const {
-  if (dt != dt_) return;
-  const Fit f = next_fit();
-  if (f.terms == 0) return;
+ErrorRecurrence::Fit ErrorRecurrence::next_fit(const Gram& G) const {
   const std::size_t m = e_.size();
-  const auto& en = e_[m - 1];
-  if (X.size() != en.size()) throw std::logic_error("ErrorRecurrence: the number of unknowns changed");
-  for (std::size_t i = 0; i < X.size(); ++i) X[i] += f.a1 * en[i];
-  if (f.terms == 2)
-    for (std::size_t i = 0; i < X.size(); ++i) X[i] += f.a2 * e_[m - 2][i];
+  if (m >= 3) {  // did the last prediction, the fit one step earlier applied to e_[m-2], e_[m-3], ..., help?
+    if (const Fit last = fit(G, m - 1); last.terms > 0) {
+      const std::size_t y = m - 1;
+      double miss = G[y][y];
+      for (int p = 0; p < last.terms; ++p) {
+        miss -= 2 * last.a[p] * G[y][y - 1 - p];
+        for (int q = 0; q < last.terms; ++q) miss += last.a[p] * last.a[q] * G[y - 1 - p][y - 1 - q];
+      }
+      if (miss > G[y][y]) return {};
+    }
+  }
+  return fit(G, m);
+}
+
+std::vector<std::size_t> ErrorRecurrence::blocks(std::span<const std::size_t> offsets) const {
+  const std::size_t n = e_.empty() ? 0 : e_.back().size();
+  if (offsets.empty()) return {0, n};
+  if (offsets.front() != 0 || offsets.back() != n || !std::ranges::is_sorted(offsets))
+    throw std::logic_error("ErrorRecurrence: the block offsets do not split the unknowns");
+  return {offsets.begin(), offsets.end()};
+}
+
+int ErrorRecurrence::terms(double dt, std::span<const std::size_t> offsets) const {
+  if (dt != dt_ || e_.empty()) return 0;
+  const auto b = blocks(offsets);
+  int most = 0;
+  for (std::size_t k = 0; k + 1 < b.size(); ++k) most = std::max(most, next_fit(gram(b[k], b[k + 1])).terms);
+  return most;
+}
+
+void ErrorRecurrence::predict(double dt, std::span<double> X, std::span<const std::size_t> offsets) const {
+  if (dt != dt_ || e_.empty()) return;
+  if (X.size() != e_.back().size()) throw std::logic_error("ErrorRecurrence: the number of unknowns changed");
+  const auto b = blocks(offsets);
+  const std::size_t m = e_.size(), nblocks = b.size() - 1;
+  // One block per thread, each summed in order: the prediction does not depend on the number of threads.
+#pragma omp parallel for schedule(dynamic)
+  for (std::size_t k = 0; k < nblocks; ++k) {
+    const Fit f = next_fit(gram(b[k], b[k + 1]));
+    for (int p = 0; p < f.terms; ++p)
+      for (std::size_t i = b[k]; i < b[k + 1]; ++i) X[i] += f.a[p] * e_[m - 1 - p][i];
+  }
 }
 
 void ErrorRecurrence::record(double dt, std::span<const double> error) {

@@ -3,21 +3,23 @@
 //
 // Step 1 of §3 starts Newton from the linear extrapolation X_e^{n+1} = X^n + (dt/dt^{n-1})(X^n - X^{n-1}); it misses
 // the converged X^{n+1} by e^{n+1} = X^{n+1} - X_e^{n+1}. The membrane modes make these errors a sequence with a
-// short linear recurrence: under the trapezoidal rule (29) a stiff mode is multiplied by r = (1 - dt l/2)/(1 + dt l/2)
-// ~ -1 per step (it rings), a soft one by r ~ 1, and a sequence made of two such families obeys
+// short linear recurrence: under the trapezoidal rule (29) a mode of stiffness l is multiplied by
+// r = (1 - dt l/2)/(1 + dt l/2) per step (a stiff one rings, r ~ -1; a soft one decays, r ~ 1), and a sequence made of
+// t such families obeys
 //
-//   e^{k} = a1 e^{k-1} + a2 e^{k-2}    (a1 = r1 + r2, a2 = -r1 r2).
+//   e^{k} = a1 e^{k-1} + ... + at e^{k-t}      (the a's: the coefficients of prod_j (z - r_j)).
 //
-// The coefficients are fitted by least squares to the last three errors (e^n on e^{n-1}, e^{n-2}; one term when
-// only two are known or the two-term fit is singular) and the next error is predicted,
+// Each membrane (block of unknowns) gets its own recurrence, its cells having their own modes: up to five terms,
+// fitted by least squares to the last two errors (e^n and e^{n-1} on the errors before each; one error and fewer
+// terms while the history is short; a term less while the fit is singular), and the next error is predicted,
 //
-//   X^(0) = X_e^{n+1} + a1 e^n + a2 e^{n-1}.
+//   X^(0) = X_e^{n+1} + a1 e^n + ... + at e^{n-t+1}.
 //
-// The prediction is skipped when the fit explains less than three quarters of e^n (relative residual above 1/2),
-// or when the last prediction (the same fit one step earlier, recomputed from the stored errors) missed e^n by more
-// than e^n itself (the recurrence stopped holding: the extrapolation alone was better). The history is dropped
-// when dt changes (the errors scale with it). Measured on §4.4 (docs/time-integration.md):
-// the prediction misses e^{n+1} by 2-3 % with the paper's cells, by 12-17 % with 100x stiffer ones.
+// A block's prediction is skipped when its fit explains less than three quarters of its errors (relative residual
+// above 1/2), or when its last prediction (the same fit one step earlier, recomputed from the stored errors) missed
+// e^n by more than e^n itself (the recurrence stopped holding: the extrapolation alone was better). The history is
+// dropped when dt changes (the errors scale with it). Measured on §4.4 (docs/time-integration.md).
+#include <array>
 #include <cstddef>
 #include <deque>
 #include <span>
@@ -27,10 +29,14 @@ namespace immerse {
 
 class ErrorRecurrence {
  public:
-  /// Terms of the fitted recurrence the next prediction uses: 0 (none), 1 or 2.
-  int terms(double dt) const;
-  /// Adds the predicted error of a step of length dt to X (nothing when terms(dt) == 0).
-  void predict(double dt, std::span<double> X) const;
+  static constexpr int kMaxTerms = 5;
+  static constexpr int kWindow = 2;  ///< errors each fit is fitted to
+
+  /// `offsets` splits the unknowns into blocks fitted separately (block b is [offsets[b], offsets[b+1]); empty: one).
+  /// The largest number of terms a block's next prediction uses (0: no block predicts).
+  int terms(double dt, std::span<const std::size_t> offsets = {}) const;
+  /// Adds the predicted error of a step of length dt to X (nothing where no recurrence holds).
+  void predict(double dt, std::span<double> X, std::span<const std::size_t> offsets = {}) const;
   /// Records the error of a step of length dt that started from the linear extrapolation.
   void record(double dt, std::span<const double> error);
   void clear();
@@ -42,15 +48,19 @@ class ErrorRecurrence {
   void restore(std::span<const double> errors, std::size_t n, double dt);
 
  private:
+  static constexpr std::size_t kDepth = kMaxTerms + kWindow + 1;  // one more to recompute the last prediction
   struct Fit {
     int terms = 0;
-    double a1 = 0, a2 = 0;
+    std::array<double, kMaxTerms> a{};
   };
-  // The fit of e_[m-1] on e_[m-2] (and e_[m-3]), which predicts e_[m].
-  Fit fit(std::size_t m) const;
-  Fit next_fit() const;
-  // Four errors: the last three for the next prediction, and one more to recompute the last prediction.
-  static constexpr std::size_t kDepth = 4;
+  using Gram = std::array<std::array<double, kDepth>, kDepth>;
+  // Dot products of the stored errors over [begin, end).
+  Gram gram(std::size_t begin, std::size_t end) const;
+  // The fit that predicts e_[m] from e_[m-1], e_[m-2], ... (m <= number stored).
+  static Fit fit(const Gram& G, std::size_t m);
+  // The fit for the next error, or none (the rules above).
+  Fit next_fit(const Gram& G) const;
+  std::vector<std::size_t> blocks(std::span<const std::size_t> offsets) const;
   std::deque<std::vector<double>> e_;
   double dt_ = 0;
 };

@@ -35,7 +35,7 @@ void MembraneIntegrator::initial_guess(const ThetaResidual& g, SolverSettings::I
   if (guess != SolverSettings::InitialGuess::Recurrence || prev_X_.size() != X0.size() || prev_dt_ != g.dt())
     return;
   extrapolated_.assign(X0.begin(), X0.end());
-  errors_.predict(g.dt(), X0);
+  errors_.predict(g.dt(), X0, g.op().membrane_offsets());
 }
 
 void MembraneIntegrator::remember(const CoupledOperator& op, double dt, std::span<const double> X) {

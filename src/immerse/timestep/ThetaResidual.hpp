@@ -43,6 +43,7 @@ class ThetaResidual {
     }
   }
   CoupledOperator& op() { return op_; }
+  const CoupledOperator& op() const { return op_; }
   double dt() const { return dt_; }
 
  private:
