@@ -67,7 +67,7 @@ TEST(ErrorRecurrence, PredictsARingingAndADecayingModeExactly) {
   for (int k = 0; k < 3; ++k) r.record(0.1, two_modes(k, 0.9, -0.95));
   EXPECT_EQ(r.terms(0.1), 2);
   EXPECT_LT(relative_difference(prediction(r, 0.1, 60), two_modes(3, 0.9, -0.95)), 1e-12);
-  // The stored history slides: the next error is predicted from the last three.
+  // A fourth error: the fit (three terms are singular for two modes: two) now on the last two errors, still exact.
   r.record(0.1, two_modes(3, 0.9, -0.95));
   EXPECT_LT(relative_difference(prediction(r, 0.1, 60), two_modes(4, 0.9, -0.95)), 1e-12);
 }
@@ -118,6 +118,7 @@ TEST(ErrorRecurrence, PredictionDoesNotDependOnTheNumberOfThreads) {
   const std::vector<std::size_t> offsets{0, 300, 600, 900, 1200};
   ErrorRecurrence rec;
   for (int k = 0; k < 8; ++k) rec.record(0.1, modes(k, {0.9, 0.5, -0.3, -0.9}, 1200, 50));
+  ASSERT_EQ(rec.terms(0.1, offsets), 4);
   const int threads = omp_get_max_threads();
   omp_set_num_threads(1);
   const auto one = prediction(rec, 0.1, 1200, offsets);
@@ -125,6 +126,35 @@ TEST(ErrorRecurrence, PredictionDoesNotDependOnTheNumberOfThreads) {
   const auto two = prediction(rec, 0.1, 1200, offsets);
   omp_set_num_threads(threads);
   EXPECT_EQ(one, two);
+  EXPECT_LT(relative_difference(one, modes(8, {0.9, 0.5, -0.3, -0.9}, 1200, 50)), 1e-8);
+}
+
+// A block whose recurrence stopped holding, an empty block and a block without errors predict nothing; the others
+// go on predicting.
+TEST(ErrorRecurrence, SkipsOnlyTheBlocksWhereNoRecurrenceHolds) {
+  const std::vector<double> ra{0.9, -0.95}, rb{0.7, -0.8};
+  const std::vector<std::size_t> offsets{0, 100, 100, 180, 240};  // blocks a, (empty), b, zero
+  auto errors = [&](int k, bool b_breaks) {
+    auto e = modes(k, ra, 100, 70);
+    const auto b = b_breaks ? random_vector(80, 200 + static_cast<unsigned>(k)) : modes(k, rb, 80, 80);
+    e.insert(e.end(), b.begin(), b.end());
+    e.resize(240, 0.0);
+    return e;
+  };
+  ErrorRecurrence rec;
+  for (int k = 0; k < 4; ++k) rec.record(0.1, errors(k, false));
+  auto p = prediction(rec, 0.1, 240, offsets);
+  EXPECT_LT(relative_difference(p, errors(4, false)), 1e-10);
+  // Block b's next error is unrelated to its recurrence, and larger than the prediction: it is skipped from now on.
+  auto e4 = errors(4, false);
+  const auto broken = random_vector(80, 300);
+  for (std::size_t i = 0; i < 80; ++i) e4[100 + i] = 10 * broken[i];
+  rec.record(0.1, e4);
+  p = prediction(rec, 0.1, 240, offsets);
+  const auto next = errors(5, false);
+  for (std::size_t i = 100; i < 240; ++i) EXPECT_EQ(p[i], 0.0);
+  const std::vector<double> pa(p.begin(), p.begin() + 100), ea(next.begin(), next.begin() + 100);
+  EXPECT_LT(relative_difference(pa, ea), 1e-10);
 }
 
 TEST(ErrorRecurrence, StopsPredictingWhenItsLastPredictionMissedByMoreThanTheError) {
@@ -154,10 +184,23 @@ TEST(ErrorRecurrence, ForgetsItsHistoryWhenTheStepChanges) {
 
 TEST(ErrorRecurrence, RestoreOfItsErrorsIsBitwise) {
   ErrorRecurrence r, s;
-  for (int k = 0; k < 4; ++k) r.record(0.1, two_modes(k, 0.8, -0.97));
+  const std::vector<double> modes_r{0.8, 0.4, -0.5, -0.97};
+  auto noisy = [&](int k) {  // a recurrence plus noise: the fits are inexact and the miss rule is exercised
+    auto e = modes(k, modes_r, 60, 60);
+    const auto n = random_vector(60, 100 + static_cast<unsigned>(k));
+    for (std::size_t i = 0; i < e.size(); ++i) e[i] += 0.05 * n[i];
+    return e;
+  };
+  for (int k = 0; k < 11; ++k) r.record(0.1, noisy(k));  // more than the eight stored: the oldest were dropped
   s.restore(r.errors(), 60, r.dt());
   EXPECT_EQ(s.errors(), r.errors());
-  EXPECT_EQ(prediction(s, 0.1, 60), prediction(r, 0.1, 60));
+  EXPECT_EQ(r.errors().size(), 8 * 60u);
+  for (int k = 11; k < 14; ++k) {  // and they go on alike
+    ASSERT_GT(r.terms(0.1), 0);
+    EXPECT_EQ(prediction(s, 0.1, 60), prediction(r, 0.1, 60));
+    r.record(0.1, noisy(k));
+    s.record(0.1, noisy(k));
+  }
   EXPECT_THROW(s.restore(std::vector<double>(61, 1.0), 60, 0.1), InputError);
   EXPECT_THROW(s.restore(std::vector<double>(540, 1.0), 60, 0.1), InputError);  // more than eight errors
 }

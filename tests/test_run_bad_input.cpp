@@ -204,6 +204,12 @@ INSTANTIATE_TEST_SUITE_P(
                  "cannot open the file: it is a directory"},
         BadInput{"frame_offered_as_checkpoint", "", {}, "good/fields_000000.h5",
                  "fields_000000.h5 is not an immerse checkpoint (no format version)"},
+        BadInput{"unknown_petsc_option", "", {"solver.petsc_options=\"-ksp_gmres_restartx 10\""}, "",
+                 "solver.petsc_options: PETSc does not know option -ksp_gmres_restartx for the 'jfnk' solver"},
+        BadInput{"petsc_option_value_rejected", "",
+                 {"solver.petsc_options=\"-ksp_type dgmres -ksp_gmres_restart 10 -ksp_dgmres_max_eigen 20\""}, "",
+                 "solver.petsc_options = '-ksp_type dgmres -ksp_gmres_restart 10 -ksp_dgmres_max_eigen 20': PETSc "
+                 "error in SNESSetFromOptions"},
         BadInput{"unknown_option", "", {}, "", "The following argument was not expected: --sett (see immerse --help)",
                  {"--sett"}}),
     [](const auto& p) { return p.param.name; });

@@ -92,6 +92,15 @@ TEST(ImmersedBoundaryOperator, TrialVelocityOfManyMembranesIsBitwiseIndependentO
   EXPECT_EQ(U[0], U[2]);
 }
 
+TEST(ImmersedBoundaryOperator, MembraneOffsetsSplitTheUnknownsByMembrane) {
+  Cells s;
+  const auto op = s.make_operator();
+  const auto offsets = op.membrane_offsets();
+  ASSERT_EQ(offsets.size(), static_cast<std::size_t>(kMembranes) + 1);
+  for (int m = 0; m <= kMembranes; ++m) EXPECT_EQ(offsets[m], 3 * s.mesh.nodes.size() * static_cast<std::size_t>(m));
+  EXPECT_EQ(offsets.back(), op.size());
+}
+
 // The start force S(X^n) f(X^n) of the next step, seen through the trial velocity at X2 (theta = 1/2 mixes it in).
 // An implicit step ends with a trial at X^{n+1}; commit takes its S(X^{n+1}) f(X^{n+1}) over. Applied forces set
 // before or after the commit, and a commit at other positions than the last trial's, must not reuse it.

@@ -113,6 +113,7 @@ Simulation::Simulation(const io::Config& config)
     throw InputError("time.scheme = \"bfgs\": the dense quasi-Newton matrix of eq. (35) is limited to " +
                      std::to_string(DenseBfgs::max_unknowns) + " unknowns and this run has " +
                      std::to_string(op_->size()) + " (use \"lbfgs\" or \"jfnk\")");
+  integrator_->prepare(op_->size());
 }
 
 void Simulation::build_membranes() {

@@ -22,11 +22,13 @@ ErrorRecurrence::Gram ErrorRecurrence::gram(std::size_t begin, std::size_t end) 
   return G;
 }
 
-ErrorRecurrence::Fit ErrorRecurrence::fit(const Gram& G, std::size_t m) {
+ErrorRecurrence::Fit ErrorRecurrence::fit(const Gram& G, std::size_t m, std::size_t unknowns) {
   if (m < 2) return {};
   for (int t = static_cast<int>(std::min<std::size_t>(kMaxTerms, m - 1)); t >= 1; --t) {
-    // Normal equations of e_[j] ~ sum_p a_p e_[j-1-p] over the targets j = m-w .. m-1.
+    // Normal equations of e_[j] ~ sum_p a_p e_[j-1-p] over the targets j = m-w .. m-1; more equations than terms,
+    // or the fit would be exact whatever the errors.
     const std::size_t w = std::min<std::size_t>(kWindow, m - static_cast<std::size_t>(t));
+    if (w * unknowns <= static_cast<std::size_t>(t)) continue;
     std::array<std::array<double, kMaxTerms>, kMaxTerms> N{};
     std::array<double, kMaxTerms> b{};
     double yy = 0;
@@ -37,8 +39,9 @@ ErrorRecurrence::Fit ErrorRecurrence::fit(const Gram& G, std::size_t m) {
         for (int q = 0; q < t; ++q) N[p][q] += G[j - 1 - p][j - 1 - q];
       }
     }
-    if (yy == 0) return {};
-    // Cholesky N = L L^T; a pivot below 1e-8 of its diagonal entry means the errors are dependent: a term less.
+    if (yy == 0) continue;
+    // Cholesky N = L L^T; a squared pivot below 1e-8 of its diagonal entry (the new error's sine to the span of the
+    // others below 1e-4) means the errors are dependent: a term less.
     std::array<std::array<double, kMaxTerms>, kMaxTerms> L{};
     bool singular = false;
     for (int k = 0; k < t && !singular; ++k) {
@@ -76,10 +79,10 @@ ErrorRecurrence::Fit ErrorRecurrence::fit(const Gram& G, std::size_t m) {
   return {};
 }
 
-ErrorRecurrence::Fit ErrorRecurrence::next_fit(const Gram& G) const {
+ErrorRecurrence::Fit ErrorRecurrence::next_fit(const Gram& G, std::size_t unknowns) const {
   const std::size_t m = e_.size();
-  if (m >= 3) {  // did the last prediction, the fit one step earlier applied to e_[m-2], e_[m-3], ..., help?
-    if (const Fit last = fit(G, m - 1); last.terms > 0) {
+  if (m >= 3) {  // did the fit one step earlier, applied to e_[m-2], e_[m-3], ..., predict e_[m-1]?
+    if (const Fit last = fit(G, m - 1, unknowns); last.terms > 0) {
       const std::size_t y = m - 1;
       double miss = G[y][y];
       for (int p = 0; p < last.terms; ++p) {
@@ -89,7 +92,7 @@ ErrorRecurrence::Fit ErrorRecurrence::next_fit(const Gram& G) const {
       if (miss > G[y][y]) return {};
     }
   }
-  return fit(G, m);
+  return fit(G, m, unknowns);
 }
 
 std::vector<std::size_t> ErrorRecurrence::blocks(std::span<const std::size_t> offsets) const {
@@ -104,7 +107,7 @@ int ErrorRecurrence::terms(double dt, std::span<const std::size_t> offsets) cons
   if (dt != dt_ || e_.empty()) return 0;
   const auto b = blocks(offsets);
   int most = 0;
-  for (std::size_t k = 0; k + 1 < b.size(); ++k) most = std::max(most, next_fit(gram(b[k], b[k + 1])).terms);
+  for (std::size_t k = 0; k + 1 < b.size(); ++k) most = std::max(most, next_fit(gram(b[k], b[k + 1]), b[k + 1] - b[k]).terms);
   return most;
 }
 
@@ -116,7 +119,7 @@ void ErrorRecurrence::predict(double dt, std::span<double> X, std::span<const st
   // One block per thread, each summed in order: the prediction does not depend on the number of threads.
 #pragma omp parallel for schedule(dynamic)
   for (std::size_t k = 0; k < nblocks; ++k) {
-    const Fit f = next_fit(gram(b[k], b[k + 1]));
+    const Fit f = next_fit(gram(b[k], b[k + 1]), b[k + 1] - b[k]);
     for (int p = 0; p < f.terms; ++p)
       for (std::size_t i = b[k]; i < b[k + 1]; ++i) X[i] += f.a[p] * e_[m - 1 - p][i];
   }

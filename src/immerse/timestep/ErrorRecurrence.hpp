@@ -16,9 +16,10 @@
 //   X^(0) = X_e^{n+1} + a1 e^n + ... + at e^{n-t+1}.
 //
 // A block's prediction is skipped when its fit explains less than three quarters of its errors (relative residual
-// above 1/2), or when its last prediction (the same fit one step earlier, recomputed from the stored errors) missed
-// e^n by more than e^n itself (the recurrence stopped holding: the extrapolation alone was better). The history is
-// dropped when dt changes (the errors scale with it). Measured on §4.4 (docs/time-integration.md).
+// above 1/2; the fit needs more equations than terms), or when the same fit one step earlier (recomputed from the
+// stored errors, whether or not it was used) would have missed e^n by more than e^n itself (the recurrence stopped
+// holding: the extrapolation alone was better). The history is dropped when dt changes (the errors scale with it).
+// Measured on §4.4 (docs/time-integration.md).
 #include <array>
 #include <cstddef>
 #include <deque>
@@ -56,10 +57,10 @@ class ErrorRecurrence {
   using Gram = std::array<std::array<double, kDepth>, kDepth>;
   // Dot products of the stored errors over [begin, end).
   Gram gram(std::size_t begin, std::size_t end) const;
-  // The fit that predicts e_[m] from e_[m-1], e_[m-2], ... (m <= number stored).
-  static Fit fit(const Gram& G, std::size_t m);
-  // The fit for the next error, or none (the rules above).
-  Fit next_fit(const Gram& G) const;
+  // The fit that predicts e_[m] from e_[m-1], e_[m-2], ... (m <= number stored) in a block of `unknowns`.
+  static Fit fit(const Gram& G, std::size_t m, std::size_t unknowns);
+  // The fit for the next error in a block, or none (the rules above).
+  Fit next_fit(const Gram& G, std::size_t unknowns) const;
   std::vector<std::size_t> blocks(std::span<const std::size_t> offsets) const;
   std::deque<std::vector<double>> e_;
   double dt_ = 0;

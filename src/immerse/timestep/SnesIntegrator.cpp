@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <sstream>
+#include <stdexcept>
 
 #include "immerse/core/Error.hpp"
 #include "immerse/timestep/PetscSession.hpp"
@@ -70,8 +71,12 @@ void SnesIntegrator::setup(std::size_t n) {
   IMMERSE_PETSC(SNESLineSearchSetType(ls, SNESLINESEARCHBASIC));  // full steps, eq. (34)
   IMMERSE_PETSC(SNESSetSolution(snes_, x_));
   IMMERSE_PETSC(PetscOptionsHasName(options_, nullptr, "-ksp_atol", &user_atol_));
-  IMMERSE_PETSC(SNESSetFromOptions(snes_));
-  IMMERSE_PETSC(SNESSetUp(snes_));
+  try {
+    IMMERSE_PETSC(SNESSetFromOptions(snes_));
+    IMMERSE_PETSC(SNESSetUp(snes_));
+  } catch (const std::runtime_error& e) {
+    throw InputError("solver.petsc_options = '" + settings_.petsc_options + "': " + e.what());
+  }
   PetscInt left = 0;
   char **names = nullptr, **values = nullptr;
   IMMERSE_PETSC(PetscOptionsLeftGet(options_, &left, &names, &values));
@@ -118,6 +123,10 @@ PetscErrorCode SnesIntegrator::converged(SNES snes, PetscInt it, PetscReal, Pets
   else if (it >= self->settings_.max_newton_its)
     *reason = SNES_DIVERGED_MAX_IT;
   return 0;
+}
+
+void SnesIntegrator::prepare(std::size_t unknowns) {
+  if (!snes_) setup(unknowns);
 }
 
 StepStats SnesIntegrator::step(CoupledOperator& op, double dt) {

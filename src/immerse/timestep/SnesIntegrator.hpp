@@ -39,6 +39,8 @@ class SnesIntegrator final : public MembraneIntegrator {
 
   StepStats step(CoupledOperator& op, double dt) override;
   std::string name() const override { return method_ == Method::NewtonKrylov ? "jfnk" : "lbfgs"; }
+  /// Creates the PETSc solver with solver.petsc_options applied; an option PETSc rejects is an InputError.
+  void prepare(std::size_t unknowns) override;
 
  private:
   void setup(std::size_t n);
