@@ -101,6 +101,32 @@ TEST(ImmersedBoundaryOperator, MembraneOffsetsSplitTheUnknownsByMembrane) {
   EXPECT_EQ(offsets.back(), op.size());
 }
 
+// An implicit step's last trial is driven and interpolated at X^{n+1}: commit takes its J(X^{n+1}) u^{n+1} over
+// (no interpolation), bitwise equal to interpolating the committed velocity; at other positions it interpolates.
+TEST(ImmersedBoundaryOperator, NodeVelocityIsTakenOverOnlyFromATrialAtTheCommittedPositions) {
+  Cells s;
+  std::vector<double> X0v;
+  {
+    const auto op = s.make_operator();
+    X0v.assign(op.positions().begin(), op.positions().end());
+  }
+  const auto X1 = shifted(X0v, 1e-2), X1b = shifted(X0v, 2e-2);
+  std::vector<double> U(X1.size()), expected(X1.size());
+  for (const auto* at : {&X1, &X1b}) {
+    auto op = s.make_operator();
+    op.trial_velocity(X1, 0.5, X1, 0.1, U);
+    const double interpolating = op.timings().interpolate;
+    op.commit(*at, 0.1);
+    if (at == &X1)
+      EXPECT_EQ(op.timings().interpolate, interpolating);
+    else
+      EXPECT_GT(op.timings().interpolate, interpolating);
+    const std::vector<double> taken(op.node_velocity().begin(), op.node_velocity().end());
+    op.committed_velocity(*at, expected);
+    EXPECT_EQ(taken, expected);
+  }
+}
+
 // The start force S(X^n) f(X^n) of the next step, seen through the trial velocity at X2 (theta = 1/2 mixes it in).
 // An implicit step ends with a trial at X^{n+1}; commit takes its S(X^{n+1}) f(X^{n+1}) over. Applied forces set
 // before or after the commit, and a commit at other positions than the last trial's, must not reuse it.

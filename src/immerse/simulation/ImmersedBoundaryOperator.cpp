@@ -117,6 +117,11 @@ void ImmersedBoundaryOperator::trial_velocity(std::span<const double> Xf, double
   timed(timings_.interpolate, [&] {
     coupler_.interpolate_velocity(trial_.u, nodes(Xi), {reinterpret_cast<Vec3*>(U.data()), U.size() / 3});
   });
+  trial_U_valid_ = Xi.data() == Xf.data() && Xi.size() == Xf.size();
+  if (trial_U_valid_) {
+    const auto u = nodes(U);
+    trial_U_.assign(u.begin(), u.end());
+  }
   trial_X_.assign(Xf.begin(), Xf.end());
 }
 
@@ -130,7 +135,12 @@ void ImmersedBoundaryOperator::commit(std::span<const double> X, double) {
   std::swap(committed_, trial_);
   const auto Xn = nodes(X);
   std::copy(Xn.begin(), Xn.end(), X_.begin());
-  timed(timings_.interpolate, [&] { coupler_.interpolate_velocity(committed_.u, X_, U_); });
+  // A trial interpolated at the positions that drove it, X^{n+1}, has J(X^{n+1}) u^{n+1} already.
+  if (trial_U_valid_ && trial_matches(X))
+    std::swap(U_, trial_U_);
+  else
+    timed(timings_.interpolate, [&] { coupler_.interpolate_velocity(committed_.u, X_, U_); });
+  trial_U_valid_ = false;
   // An implicit step's last trial was driven by X^{n+1} itself: its S(X^{n+1}) f(X^{n+1}) is the next step's start.
   // Otherwise the start force is computed when a trial first needs it (never by the explicit schemes, theta = 1).
   start_valid_ = trial_matches(X);

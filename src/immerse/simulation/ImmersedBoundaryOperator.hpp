@@ -8,7 +8,8 @@
 //
 // with F^{n+1/2} = (1 - theta) S(X^n) f(X^n) + theta S(Xf) f(Xf); S(X^n) f(X^n) is taken over from the last trial
 // when that was driven by X^{n+1} (as an implicit step's is), else computed once, when a trial with theta < 1
-// first needs it. The committed fluid state is never modified by trial steps; commit() swaps the last trial in.
+// first needs it. The committed fluid state is never modified by trial steps; commit() swaps the last trial in, and
+// takes its node velocity J(X^{n+1}) u^{n+1} over when that trial was driven and interpolated at X^{n+1}.
 // All membranes' nodes are concatenated in one array; errors name the membrane and its local node or element.
 #include <algorithm>
 #include <span>
@@ -78,6 +79,8 @@ class ImmersedBoundaryOperator final : public CoupledOperator {
   FaceField force_;             ///< S(Xf) f(Xf) of the last trial
   FaceField mixed_;             ///< F^{n+1/2} of the last trial (allocated by the first trial with theta < 1)
   std::vector<double> trial_X_;  ///< the Xf of the last completed trial (empty when none can be reused at commit)
+  std::vector<Vec3> trial_U_;    ///< J(Xi) u of the last trial, when trial_U_valid_ (it was interpolated at Xi = Xf)
+  bool trial_U_valid_ = false;
   std::vector<Vec3> F_;                                 ///< nodal forces, all membranes
   std::vector<Vec3> applied_;                           ///< external nodal forces, all membranes
   std::vector<std::vector<Vec3>> Xm_, Fm_;              ///< per-membrane scratch for compute_force
