@@ -93,7 +93,11 @@ PetscErrorCode SnesIntegrator::form_function(SNES, Vec x, Vec f, void* ctx) {
   const PetscScalar* xs;
   PetscScalar* fs;
   PetscCall(VecGetArrayRead(x, &xs));
-  for (std::size_t i = 0; i < self->n_; ++i) self->X_[i] = self->scale_ * xs[i];
+  const long n = static_cast<long>(self->n_);
+  const double scale = self->scale_;
+  double* const X = self->X_.data();
+#pragma omp parallel for schedule(static) if (n > 100000)
+  for (long i = 0; i < n; ++i) X[i] = scale * xs[i];
   PetscCall(VecRestoreArrayRead(x, &xs));
   try {
     (*self->residual_)(self->X_, self->g_);
@@ -102,7 +106,9 @@ PetscErrorCode SnesIntegrator::form_function(SNES, Vec x, Vec f, void* ctx) {
     return PETSC_ERR_USER;
   }
   PetscCall(VecGetArray(f, &fs));
-  for (std::size_t i = 0; i < self->n_; ++i) fs[i] = self->g_[i] / self->scale_;
+  const double* const g = self->g_.data();
+#pragma omp parallel for schedule(static) if (n > 100000)
+  for (long i = 0; i < n; ++i) fs[i] = g[i] / scale;
   PetscCall(VecRestoreArray(f, &fs));
   return 0;
 }

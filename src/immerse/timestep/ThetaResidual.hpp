@@ -25,8 +25,9 @@ class ThetaResidual {
     op_.trial_velocity(X, theta_, X, dt_, U_);
     const auto Xn = op_.positions();
     const auto Un = op_.node_velocity();
-    for (std::size_t i = 0; i < X.size(); ++i)
-      g[i] = X[i] - Xn[i] - dt_ * ((1.0 - theta_) * Un[i] + theta_ * U_[i]);
+    const long n = static_cast<long>(X.size());
+#pragma omp parallel for schedule(static) if (n > 100000)
+    for (long i = 0; i < n; ++i) g[i] = X[i] - Xn[i] - dt_ * ((1.0 - theta_) * Un[i] + theta_ * U_[i]);
   }
   /// True when the operator's trial state was produced by exactly these positions (so it can be committed).
   bool trial_matches(std::span<const double> X) const { return op_.trial_matches(X); }
