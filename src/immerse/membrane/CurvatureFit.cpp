@@ -5,6 +5,7 @@
 #include <cmath>
 #include <string>
 
+#include "immerse/core/Cholesky_K.hpp"
 #include "immerse/core/Error.hpp"
 #include "immerse/membrane/BalancedRange.hpp"
 
@@ -18,37 +19,6 @@ constexpr int kTerms = 14;  // monomials s^a t^b, 1 <= a + b <= 4
 std::array<double, kTerms> monomials(double S, double T) {
   const double S2 = S * S, T2 = T * T;
   return {S, T, S2, S * T, T2, S2 * S, S2 * T, S * T2, T2 * T, S2 * S2, S2 * S * T, S2 * T2, S * T2 * T, T2 * T2};
-}
-
-/// Cholesky factor (lower, in place) of the symmetric matrix M; false if M is not positive definite enough.
-bool cholesky(std::array<double, kTerms * kTerms>& M) {
-  for (int j = 0; j < kTerms; ++j) {
-    double d = M[j * kTerms + j];
-    for (int k = 0; k < j; ++k) d -= M[j * kTerms + k] * M[j * kTerms + k];
-    if (!(d > 1e-12)) return false;
-    d = std::sqrt(d);
-    M[j * kTerms + j] = d;
-    for (int i = j + 1; i < kTerms; ++i) {
-      double s = M[i * kTerms + j];
-      for (int k = 0; k < j; ++k) s -= M[i * kTerms + k] * M[j * kTerms + k];
-      M[i * kTerms + j] = s / d;
-    }
-  }
-  return true;
-}
-
-/// Solves L L^T x = r with the factor from cholesky().
-void cholesky_solve(const std::array<double, kTerms * kTerms>& L, std::array<double, kTerms>& r) {
-  for (int i = 0; i < kTerms; ++i) {
-    double s = r[i];
-    for (int k = 0; k < i; ++k) s -= L[i * kTerms + k] * r[k];
-    r[i] = s / L[i * kTerms + i];
-  }
-  for (int i = kTerms - 1; i >= 0; --i) {
-    double s = r[i];
-    for (int k = i + 1; k < kTerms; ++k) s -= L[k * kTerms + i] * r[k];
-    r[i] = s / L[i * kTerms + i];
-  }
 }
 
 }  // namespace
@@ -93,7 +63,10 @@ CurvatureFit::CurvatureFit(const Mesh& mesh, const std::vector<Vec3>& reference)
     }
     for (int p = 0; p < kTerms; ++p)
       for (int q = p + 1; q < kTerms; ++q) M[p * kTerms + q] = M[q * kTerms + p];
-    require(nodes.size() >= kTerms && cholesky(M), "membrane mesh node " + std::to_string(i),
+    const bool factored = nodes.size() >= kTerms && cholesky_factor(M.data(), kTerms, kTerms, [](double pivot, double) {
+                            return pivot > 1e-12;
+                          });
+    require(factored, "membrane mesh node " + std::to_string(i),
             "a neighbourhood that determines the quartic curvature fit (well-shaped elements around it)");
     // Row r of (A^T A)^{-1} A^T for the five derivative coefficients: solve with the unit vectors e_0..e_4
     // (the inverse is symmetric), then weights for neighbour p = (A^T A)^{-1}_{k,:} . A[p], with the chart
@@ -101,7 +74,7 @@ CurvatureFit::CurvatureFit(const Mesh& mesh, const std::vector<Vec3>& reference)
     std::array<std::array<double, kTerms>, 5> inv{};
     for (int k = 0; k < 5; ++k) {
       inv[k][k] = 1;
-      cholesky_solve(M, inv[k]);
+      cholesky_solve(M.data(), kTerms, kTerms, inv[k].data());
     }
     const std::array<double, 5> scale{1 / h, 1 / h, 2 / (h * h), 1 / (h * h), 2 / (h * h)};
     for (std::size_t r = 0; r < nodes.size(); ++r) {

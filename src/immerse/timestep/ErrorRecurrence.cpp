@@ -1,10 +1,10 @@
 #include "immerse/timestep/ErrorRecurrence.hpp"
 
 #include <algorithm>
-#include <cmath>
 #include <stdexcept>
 #include <string>
 
+#include "immerse/core/Cholesky_K.hpp"
 #include "immerse/core/Error.hpp"
 
 namespace immerse {
@@ -29,49 +29,25 @@ ErrorRecurrence::Fit ErrorRecurrence::fit(const Gram& G, std::size_t m, std::siz
     // or the fit would be exact whatever the errors.
     const std::size_t w = std::min<std::size_t>(kWindow, m - static_cast<std::size_t>(t));
     if (w * unknowns <= static_cast<std::size_t>(t)) continue;
-    std::array<std::array<double, kMaxTerms>, kMaxTerms> N{};
+    std::array<double, kMaxTerms * kMaxTerms> N{};
     std::array<double, kMaxTerms> b{};
     double yy = 0;
     for (std::size_t j = m - w; j < m; ++j) {
       yy += G[j][j];
       for (int p = 0; p < t; ++p) {
         b[p] += G[j][j - 1 - p];
-        for (int q = 0; q < t; ++q) N[p][q] += G[j - 1 - p][j - 1 - q];
+        for (int q = 0; q < t; ++q) N[p * kMaxTerms + q] += G[j - 1 - p][j - 1 - q];
       }
     }
     if (yy == 0) continue;
-    // Cholesky N = L L^T; a squared pivot below 1e-8 of its diagonal entry (the new error's sine to the span of the
-    // others below 1e-4) means the errors are dependent: a term less.
-    std::array<std::array<double, kMaxTerms>, kMaxTerms> L{};
-    bool singular = false;
-    for (int k = 0; k < t && !singular; ++k) {
-      double d = N[k][k];
-      for (int j = 0; j < k; ++j) d -= L[k][j] * L[k][j];
-      if (!(d > 1e-8 * N[k][k])) {
-        singular = true;
-        break;
-      }
-      L[k][k] = std::sqrt(d);
-      for (int i = k + 1; i < t; ++i) {
-        double s = N[i][k];
-        for (int j = 0; j < k; ++j) s -= L[i][j] * L[k][j];
-        L[i][k] = s / L[k][k];
-      }
-    }
-    if (singular) continue;
+    // A squared pivot below 1e-8 of its diagonal entry (the new error's sine to the span of the others below 1e-4)
+    // means the errors are dependent: a term less.
+    if (!cholesky_factor(N.data(), t, kMaxTerms, [](double pivot, double diagonal) { return pivot > 1e-8 * diagonal; }))
+      continue;
     Fit f;
     f.terms = t;
-    std::array<double, kMaxTerms> z{};
-    for (int i = 0; i < t; ++i) {
-      double s = b[i];
-      for (int j = 0; j < i; ++j) s -= L[i][j] * z[j];
-      z[i] = s / L[i][i];
-    }
-    for (int i = t - 1; i >= 0; --i) {
-      double s = z[i];
-      for (int j = i + 1; j < t; ++j) s -= L[j][i] * f.a[j];
-      f.a[i] = s / L[i][i];
-    }
+    f.a = b;
+    cholesky_solve(N.data(), t, kMaxTerms, f.a.data());
     double res = yy;  // squared residual of the fit
     for (int p = 0; p < t; ++p) res -= f.a[p] * b[p];
     return res < 0.25 * yy ? f : Fit{};  // relative residual below 1/2
