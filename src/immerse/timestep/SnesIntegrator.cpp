@@ -96,7 +96,7 @@ PetscErrorCode SnesIntegrator::form_function(SNES, Vec x, Vec f, void* ctx) {
   const long n = static_cast<long>(self->n_);
   const double scale = self->scale_;
   double* const X = self->X_.data();
-#pragma omp parallel for schedule(static) if (n > 100000)
+#pragma omp parallel for schedule(static)
   for (long i = 0; i < n; ++i) X[i] = scale * xs[i];
   PetscCall(VecRestoreArrayRead(x, &xs));
   try {
@@ -107,7 +107,7 @@ PetscErrorCode SnesIntegrator::form_function(SNES, Vec x, Vec f, void* ctx) {
   }
   PetscCall(VecGetArray(f, &fs));
   const double* const g = self->g_.data();
-#pragma omp parallel for schedule(static) if (n > 100000)
+#pragma omp parallel for schedule(static)
   for (long i = 0; i < n; ++i) fs[i] = g[i] / scale;
   PetscCall(VecRestoreArray(f, &fs));
   return 0;

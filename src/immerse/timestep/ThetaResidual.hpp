@@ -26,7 +26,7 @@ class ThetaResidual {
     const auto Xn = op_.positions();
     const auto Un = op_.node_velocity();
     const long n = static_cast<long>(X.size());
-#pragma omp parallel for schedule(static) if (n > 100000)
+#pragma omp parallel for schedule(static)
     for (long i = 0; i < n; ++i) g[i] = X[i] - Xn[i] - dt_ * ((1.0 - theta_) * Un[i] + theta_ * U_[i]);
   }
   /// True when the operator's trial state was produced by exactly these positions (so it can be committed).
