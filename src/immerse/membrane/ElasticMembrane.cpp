@@ -147,6 +147,8 @@ Mat3 projector(const Vec3& n) { return Mat3::identity() - Mat3::outer(n, n); }
 // independent. Every entry a pass reads was written earlier in the same call.
 struct ElasticMembrane::Work {
   std::vector<membrane_k::SymTensor> node_tau;  // tension (18) averaged at nodes
+  std::vector<Vec3> slot_n;                     // unit normal at each element node (6 e + k)
+  std::vector<membrane_k::SymTensor> slot_tau;  // tension (18) at each element node
   std::vector<Vec3> node_n;                     // unit normal at nodes
   std::vector<Vec3> node_nfit;                  // fitted unit normal N at nodes (bending)
   std::vector<Mat3> node_kappa;                 // fitted curvature tensor (40) at nodes (bending)
@@ -217,48 +219,57 @@ void ElasticMembrane::check_size(const std::vector<Vec3>& X) const {
 }
 
 // Node passes. A node's value is the mean over its element-node slots (ascending element order) of a quantity
-// evaluated at that element node: no per-element-node array is stored, and the result does not depend on the
-// thread count.
+// evaluated at that element node, and the result does not depend on the thread count.
 
-// Normal n and (optionally) tension (17)-(20), (18) from (39) at each element node, averaged at the nodes.
+// Normal n and (optionally) tension (17)-(20), (18) from (39) at each element node, averaged at the nodes. The
+// element-node values are computed element by element (an element's six nodes gathered once, its chord normal
+// once) into per-slot arrays, then averaged node by node.
 void ElasticMembrane::node_pass(const std::vector<Vec3>& X, bool with_tension, Work& w) const {
-  const int N = static_cast<int>(num_nodes());
-  w.node_n.resize(N);
-  if (with_tension) w.node_tau.resize(N);
+  const int N = static_cast<int>(num_nodes()), E = static_cast<int>(num_elements());
+  w.slot_n.resize(6 * static_cast<std::size_t>(E));
+  if (with_tension) w.slot_tau.resize(6 * static_cast<std::size_t>(E));
   int bad = INT_MAX;
   std::visit(
       [&](const auto& W) {
-#pragma omp parallel reduction(min : bad)
-        for (auto [i, end] = balanced_node_range(inc_start_); i < end; ++i) {
-          membrane_k::SymTensor tau;
-          Vec3 n;
-          for (int j = inc_start_[i]; j < inc_start_[i + 1]; ++j) {
-            const int slot = inc_[j], e = slot / 6, k = slot % 6;
-            const auto& el = elements_[e];
-            const Tangents t = slot_tangents(el, k, X);
+#pragma omp parallel for schedule(static) reduction(min : bad)
+        for (int e = 0; e < E; ++e) {
+          const Nodes x = element_nodes(elements_[e], X);
+          const Vec3 chord = chord_normal(x);
+          for (int k = 0; k < 6; ++k) {
+            const int slot = 6 * e + k;
+            Tangents t;
+            node_derivatives(k, [&](int j) { return x[j]; }, t.a_xi, t.a_eta);
             const Vec3 c = cross(t.a_xi, t.a_eta);  // J n, as in membrane_k::frame (dual basis not needed here)
-            if (!jacobian_ok(t, chord_normal(el, X))) {
+            if (!jacobian_ok(t, chord)) {
               bad = std::min(bad, e);
-              continue;
+              break;
             }
             const double J = norm(c);
             const Vec3 nk = c * (1 / J);
-            n += nk;
+            w.slot_n[slot] = nk;
             if (!with_tension) continue;
             const RefMetric g = load_metric(ref_node_, slot);
             const double r = J / g.J;  // e^{A1} (19)
-            tau += membrane_k::tension(W.at_area_ratio(r, membrane_k::second_invariant(t, g)), 1 / r,
-                                       membrane_k::left_cauchy_green(t, g), nk);
-          }
-          w.node_n[i] = normalized(n);
-          if (with_tension) {
-            tau *= 1.0 / (inc_start_[i + 1] - inc_start_[i]);
-            w.node_tau[i] = tau;
+            w.slot_tau[slot] = membrane_k::tension(W.at_area_ratio(r, membrane_k::second_invariant(t, g)), 1 / r,
+                                                   membrane_k::left_cauchy_green(t, g), nk);
           }
         }
       },
       law_);
   throw_if_bad(bad);
+  w.node_n.resize(N);
+  if (with_tension) w.node_tau.resize(N);
+#pragma omp parallel
+  for (auto [i, end] = balanced_node_range(inc_start_); i < end; ++i) {
+    Vec3 n;
+    for (int j = inc_start_[i]; j < inc_start_[i + 1]; ++j) n += w.slot_n[inc_[j]];
+    w.node_n[i] = normalized(n);
+    if (!with_tension) continue;
+    membrane_k::SymTensor tau;
+    for (int j = inc_start_[i]; j < inc_start_[i + 1]; ++j) tau += w.slot_tau[inc_[j]];
+    tau *= 1.0 / (inc_start_[i + 1] - inc_start_[i]);
+    w.node_tau[i] = tau;
+  }
 }
 
 // Bending moments (25), m = kappa_B (kappa - kappa_m^R P), P = I - N N, with the nodal normal N and curvature
