@@ -163,6 +163,26 @@ TEST(Integrators, BadNamesAndSettingsAreRejected) {
   }
 }
 
+// The differencing of (36) is PETSc's MatMFFD: its -mat_mffd_* options are taken from solver.petsc_options (they
+// were once reported as unknown), and change the products.
+TEST(Integrators, MatrixFreeDifferencingOptionsAreTaken) {
+  SolverSettings coarse;
+  coarse.petsc_options = "-mat_mffd_type ds -mat_mffd_err 1e-4";
+  auto a = make_toy(), b = make_toy();
+  auto ja = make_integrator("jfnk", {}), jb = make_integrator("jfnk", coarse);
+  for (int i = 0; i < 3; ++i) {
+    ASSERT_TRUE(ja->step(a, 0.05).converged);
+    const auto st = jb->step(b, 0.05);
+    ASSERT_TRUE(st.converged) << st.failure;
+  }
+  bool differ = false;
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    differ = differ || a.positions()[i] != b.positions()[i];
+    EXPECT_NEAR(a.positions()[i], b.positions()[i], 1e-7);
+  }
+  EXPECT_TRUE(differ) << "-mat_mffd_err had no effect on the products";
+}
+
 namespace {
 // Fails every fluid step longer than a threshold, as a node leaving the domain would.
 class Fragile final : public CoupledOperator {

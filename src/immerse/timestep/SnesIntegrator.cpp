@@ -50,6 +50,12 @@ void SnesIntegrator::setup(std::size_t n) {
     IMMERSE_PETSC(MatCreateSNESMF(snes_, &J_));
     IMMERSE_PETSC(PetscObjectSetOptions(reinterpret_cast<PetscObject>(J_), options_));
     IMMERSE_PETSC(MatMFFDSetType(J_, MATMFFD_WP));  // eq. (37)
+    {  // -mat_mffd_* options are read by the matrix's MatMFFD context, a PETSc object of its own
+      void* mffd = nullptr;
+      IMMERSE_PETSC(MatShellGetContext(J_, &mffd));
+      IMMERSE_PETSC(PetscObjectSetOptions(static_cast<PetscObject>(mffd), options_));
+      IMMERSE_PETSC(MatSetFromOptions(J_));
+    }
     IMMERSE_PETSC(SNESSetJacobian(snes_, J_, J_, MatMFFDComputeJacobian, nullptr));
     KSP ksp;
     PC pc;
