@@ -515,11 +515,12 @@ std::size_t ElasticMembrane::memory_bytes() const {
                                  (inc_start_.size() + inc_.size()) * sizeof(int) +
                                  (ref_node_.size() + ref_quad_.size() + kappa_ref_.size()) * sizeof(double) +
                                  (fit_ ? fit_->memory_bytes() : 0);
-  // Workspace of compute_force (kept per calling thread): per node n, and tau (eq. 42 tension) or N, kappa, m and
-  // q (bending); per element F_e and the lumping fractions (eq. 42); the energy method's per-element-node forces.
+  // Workspace of compute_force (kept per calling thread): per node and per element node n, and tau (eq. 42
+  // tension) or N, kappa, m and q (bending); per element F_e and the lumping fractions (eq. 42); the energy
+  // method's per-element-node forces.
   const bool bending = bending_.kappa_B > 0, energy = method_ == ForceMethod::Energy;
-  const std::size_t work = (energy && !bending ? 0 : N * sizeof(Vec3)) +
-                           (energy ? 0 : N * sizeof(membrane_k::SymTensor)) +
+  const std::size_t work = (energy && !bending ? 0 : (N + 6 * E) * sizeof(Vec3)) +
+                           (energy ? 0 : (N + 6 * E) * sizeof(membrane_k::SymTensor)) +
                            (bending ? N * 2 * (sizeof(Mat3) + sizeof(Vec3)) : 0) +
                            (energy && !bending ? 0 : E * (sizeof(Vec3) + sizeof(std::array<double, 6>))) +
                            (energy ? 6 * E * sizeof(Vec3) : 0);
