@@ -262,13 +262,16 @@ void ElasticMembrane::node_pass(const std::vector<Vec3>& X, bool with_tension, W
 #pragma omp parallel
   for (auto [i, end] = balanced_node_range(inc_start_); i < end; ++i) {
     Vec3 n;
-    for (int j = inc_start_[i]; j < inc_start_[i + 1]; ++j) n += w.slot_n[inc_[j]];
-    w.node_n[i] = normalized(n);
-    if (!with_tension) continue;
     membrane_k::SymTensor tau;
-    for (int j = inc_start_[i]; j < inc_start_[i + 1]; ++j) tau += w.slot_tau[inc_[j]];
-    tau *= 1.0 / (inc_start_[i + 1] - inc_start_[i]);
-    w.node_tau[i] = tau;
+    for (int j = inc_start_[i]; j < inc_start_[i + 1]; ++j) {
+      n += w.slot_n[inc_[j]];
+      if (with_tension) tau += w.slot_tau[inc_[j]];
+    }
+    w.node_n[i] = normalized(n);
+    if (with_tension) {
+      tau *= 1.0 / (inc_start_[i + 1] - inc_start_[i]);
+      w.node_tau[i] = tau;
+    }
   }
 }
 
