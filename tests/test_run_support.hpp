@@ -59,7 +59,9 @@ inline std::string read_text(const fs::path& path) {
 /// A started `immerse ARGS...` with its stdout and stderr going to files.
 class ImmerseProcess {
  public:
-  ImmerseProcess(const std::vector<std::string>& args, const fs::path& log_prefix)
+  /// `env`: NAME=VALUE entries set for the child (replacing inherited ones of the same name).
+  ImmerseProcess(const std::vector<std::string>& args, const fs::path& log_prefix,
+                 const std::vector<std::string>& env = {})
       : out_(log_prefix.string() + ".stdout"), err_(log_prefix.string() + ".stderr") {
     std::vector<std::string> argv_s{immerse_program().string()};
     argv_s.insert(argv_s.end(), args.begin(), args.end());
@@ -70,12 +72,18 @@ class ImmerseProcess {
     // every exit status into its own. The rest of the inherited environment is kept.
     std::vector<std::string> env_s;
     std::string asan = "ASAN_OPTIONS=detect_leaks=0";
+    auto overridden = [&](const std::string& v) {
+      for (const auto& e : env)
+        if (v.rfind(e.substr(0, e.find('=') + 1), 0) == 0) return true;
+      return false;
+    };
     for (char** e = environ; *e; ++e) {
       const std::string v = *e;
       if (v.rfind("ASAN_OPTIONS=", 0) == 0) asan = v + ":detect_leaks=0";
-      else env_s.push_back(v);
+      else if (!overridden(v)) env_s.push_back(v);
     }
     env_s.push_back(asan);
+    env_s.insert(env_s.end(), env.begin(), env.end());
     std::vector<char*> envp;
     for (auto& v : env_s) envp.push_back(v.data());
     envp.push_back(nullptr);
@@ -118,9 +126,10 @@ struct RunResult {
   std::string out, err;
 };
 
-/// Runs `immerse ARGS...` to its end.
-inline RunResult run_immerse(const std::vector<std::string>& args, const fs::path& log_prefix) {
-  ImmerseProcess p(args, log_prefix);
+/// Runs `immerse ARGS...` to its end (`env` as for ImmerseProcess).
+inline RunResult run_immerse(const std::vector<std::string>& args, const fs::path& log_prefix,
+                             const std::vector<std::string>& env = {}) {
+  ImmerseProcess p(args, log_prefix, env);
   const int status = p.wait();
   return {status, p.out(), p.err()};
 }

@@ -29,9 +29,10 @@ struct fftw_plan_s;  // FFTW's plan type (fftw_plan is a pointer to it)
 
 namespace immerse {
 
-/// How hard FFTW searches for fast plans: Measure times candidate algorithms (about 1.5x faster transforms at 64³,
-/// planning costs up to seconds, worth it for a long run); Estimate plans instantly (for the many small,
-/// short-lived solvers of tests and verification studies).
+/// How FFTW chooses its plans. Estimate plans instantly by FFTW's heuristics: the same plan in every process and
+/// for every thread count, so results are bitwise reproducible (a simulation's default, `fluid.fft_planning`).
+/// Measure times candidate algorithms (faster transforms, planning costs up to seconds): on a machine whose load
+/// varies the timings, and so the plans and their round-off, can differ from one run to the next.
 enum class FftPlanning { Estimate, Measure };
 
 /// Which unknowns a solver works on: velocity component 0, 1, 2 (faces), or the cell-centred pressure.

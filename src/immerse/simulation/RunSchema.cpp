@@ -92,6 +92,11 @@ ConfigSchema run_schema() {
                "initial velocity: at rest, the linear (Couette) profile between the moving walls, or the steady "
                "flow driven by fluid.body_force between resting walls (the discrete Poiseuille solution)");
 
+  s.add_string("fluid.fft_planning", "estimate", {"estimate", "measure"},
+               "FFTW plans of the fast solvers: estimate (the same plans in every run: results bitwise reproducible "
+               "across runs, restarts and thread counts) or measure (FFTW times candidate plans: the fluid step "
+               "5-20 % faster, but the choice and so the round-off may differ from run to run)");
+
   s.add_string("coupling.kernel", "roma3", {"roma3", "peskin4"},
                "discrete delta: Roma-Peskin-Berger 3-point of eq. (8), or Peskin's 4-point");
 

@@ -100,7 +100,8 @@ std::string membrane_name(std::size_t m) { return "membrane[" + std::to_string(m
 Simulation::Simulation(const io::Config& config)
     : config_(config),
       grid_(make_grid(config)),
-      fluid_(grid_, make_fluid(config)),
+      fluid_(grid_, make_fluid(config),
+             config.get<std::string>("fluid.fft_planning") == "measure" ? FftPlanning::Measure : FftPlanning::Estimate),
       coupler_(grid_, delta_kernel(config.get<std::string>("coupling.kernel"))),
       stepper_(config.get<double>("time.dt"), config.get<double>("time.dt_min")) {
   build_membranes();

@@ -1,0 +1,57 @@
+// A run is reproducible bit for bit in separate processes: with one and with two threads, and when continued from
+// a checkpoint by a new process. The grid (44^3 cells) is above MacGeom::kMinCellsForThreads, so the fluid
+// solvers' loops and FFTW's transforms run threaded with two threads. This holds with fluid.fft_planning =
+// "estimate" (the default), whose FFTW plans do not depend on timings; with "measure" the plans, and so the
+// round-off, may change from one process to the next (docs/performance.md, "Reproducibility").
+#include <gtest/gtest.h>
+
+#include "immerse/io/Checkpoint.hpp"
+#include "test_run_support.hpp"
+
+using namespace immerse;
+using namespace immerse::testing;
+
+namespace {
+
+constexpr int kSteps = 4;
+
+std::vector<std::string> threaded_sets(int steps) {
+  auto s = small_membrane_sets(steps);
+  s.insert(s.end(), {"grid.nx=44", "grid.ny=44", "grid.nz=44", "membrane[0].mesh.level=2"});
+  return s;
+}
+
+int run(const fs::path& out, int steps, int threads, const fs::path& restart = {}) {
+  const auto args = run_args(scenario_file("oscillating_membrane_quick.toml"), out, threaded_sets(steps), restart);
+  const auto r = run_immerse(args, out.string() + "_log", {"OMP_NUM_THREADS=" + std::to_string(threads)});
+  EXPECT_EQ(r.err, "");
+  return r.status;
+}
+
+TEST(Reproducibility, RunsWithOneAndTwoThreadsInSeparateProcessesAreBitwiseIdentical) {
+  ScratchDir dir("reproducible");
+  ASSERT_EQ(run(dir / "one", kSteps, 1), 0);
+  ASSERT_EQ(run(dir / "two", kSteps, 2), 0);
+  const auto one = io::Checkpoint::read(dir / "one" / "checkpoint.h5");
+  const auto two = io::Checkpoint::read(dir / "two" / "checkpoint.h5");
+  EXPECT_EQ(one.get_int("step"), kSteps);
+  EXPECT_TRUE(one == two) << "checksums " << one.checksum() << " vs " << two.checksum();
+  const auto rows = without_wall_clock(read_csv(dir / "one" / "diagnostics.csv"));
+  EXPECT_EQ(rows.size(), std::size_t(kSteps + 2));
+  EXPECT_EQ(rows, without_wall_clock(read_csv(dir / "two" / "diagnostics.csv")));
+}
+
+TEST(Reproducibility, RestartInANewProcessContinuesBitwise) {
+  ScratchDir dir("reproducible");
+  ASSERT_EQ(run(dir / "whole", kSteps, 2), 0);
+  ASSERT_EQ(run(dir / "split", kSteps / 2, 2), 0);
+  ASSERT_EQ(run(dir / "split", kSteps, 2, dir / "split" / "checkpoint.h5"), 0);
+  const auto whole = io::Checkpoint::read(dir / "whole" / "checkpoint.h5");
+  const auto split = io::Checkpoint::read(dir / "split" / "checkpoint.h5");
+  EXPECT_EQ(split.get_int("step"), kSteps);
+  EXPECT_TRUE(whole == split) << "checksums " << whole.checksum() << " vs " << split.checksum();
+  EXPECT_EQ(without_wall_clock(read_csv(dir / "whole" / "diagnostics.csv")),
+            without_wall_clock(read_csv(dir / "split" / "diagnostics.csv")));
+}
+
+}  // namespace
