@@ -1,6 +1,7 @@
 // The coupled operator of §3 (ImmersedBoundaryOperator) with several membranes: the trial velocity does not depend
 // on the thread count (membranes are shared among threads), the start-of-step force is taken over from an implicit
-// step's last trial only when that is the force at the committed positions, and a failing membrane is named.
+// step's last trial only when that is the force at the committed positions, the prepared fluid step only for the
+// committed state and dt, and a failing membrane is named.
 #include <gtest/gtest.h>
 #include <omp.h>
 
@@ -47,10 +48,19 @@ struct Cells {
       X0.push_back(x);
     }
   }
-  ImmersedBoundaryOperator make_operator() {
+  std::vector<const ElasticMembrane*> pointers() const {
     std::vector<const ElasticMembrane*> ms;
     for (const auto& m : membranes) ms.push_back(&m);
-    return ImmersedBoundaryOperator(fluid, coupler, ms, X0, fluid.initial_state());
+    return ms;
+  }
+  ImmersedBoundaryOperator make_operator() {
+    return ImmersedBoundaryOperator(fluid, coupler, pointers(), X0, fluid.initial_state());
+  }
+  /// A new operator at the committed positions of `op` with the fluid state `f` (nothing prepared yet).
+  ImmersedBoundaryOperator make_operator(const ImmersedBoundaryOperator& op, const FluidState& f) {
+    std::vector<std::vector<Vec3>> X;
+    for (std::size_t m = 0; m < op.num_membranes(); ++m) X.push_back(op.membrane_positions(m));
+    return ImmersedBoundaryOperator(fluid, coupler, pointers(), X, f);
   }
 };
 
@@ -171,6 +181,51 @@ TEST(ImmersedBoundaryOperator, StartForceIsTakenOverOnlyWhenItIsTheOneAtTheCommi
   EXPECT_EQ(next_velocity(other), next_velocity(invalidated));
   // ... and not the trial's: a commit at X1 (takeover) with the same fluid state gives another velocity.
   EXPECT_NE(next_velocity(other), next_velocity(plain));
+}
+
+// The force-independent part of the fluid step is prepared once and shared by the trials with the committed state
+// and dt it was made for. Each trial of an operator that has prepared before (for the same state and dt, for another
+// dt, for the state before the last commit) is bitwise the trial of an operator freshly made in the same state; the
+// inequalities show that a stale prepared step (another dt, the state before the commit) would have been seen.
+TEST(ImmersedBoundaryOperator, TrialsReuseThePreparedFluidStepOnlyForTheCommittedStateAndDt) {
+  Cells s;
+  auto op = s.make_operator();
+  const std::vector<double> X0v(op.positions().begin(), op.positions().end());
+  const auto X1 = shifted(X0v, 1e-2), X1b = shifted(X0v, 2e-2), X2 = shifted(X1, 1e-2), X2b = shifted(X1, 2e-2);
+  const auto trial = [](ImmersedBoundaryOperator& o, const std::vector<double>& X, double dt) {
+    std::vector<double> u(o.size());
+    o.trial_velocity(X, 0.5, X, dt, u);
+    return u;
+  };
+  // The trial of a new operator at the committed positions of `like`, from the fluid state f (default: like's).
+  const auto fresh_trial = [&](const ImmersedBoundaryOperator& like, const std::vector<double>& X, double dt,
+                               const FluidState* f = nullptr) {
+    auto o = s.make_operator(like, f ? *f : like.fluid_state());
+    return trial(o, X, dt);
+  };
+  // Step 1 (forward Euler in the fluid): a second trial with the same dt, then trials with another dt and back.
+  trial(op, X1, 0.1);
+  const auto u1b = trial(op, X1b, 0.1);
+  EXPECT_EQ(u1b, fresh_trial(op, X1b, 0.1));
+  const auto u1b_half = trial(op, X1b, 0.05);
+  EXPECT_EQ(u1b_half, fresh_trial(op, X1b, 0.05));
+  EXPECT_NE(u1b_half, u1b);
+  EXPECT_EQ(trial(op, X1b, 0.1), u1b);
+  // Step 2 (Adams–Bashforth): committed at X1 after a trial there with dt = 0.1, then trials with that same dt.
+  const FluidState start = op.fluid_state();
+  trial(op, X1, 0.1);
+  op.commit(X1, 0.1);
+  ASSERT_EQ(op.fluid_state().step, 1);
+  const auto u2 = trial(op, X2, 0.1);
+  EXPECT_EQ(u2, fresh_trial(op, X2, 0.1));
+  EXPECT_NE(u2, fresh_trial(op, X2, 0.1, &start));  // what the step prepared before the commit would give
+  const auto u2b = trial(op, X2b, 0.1);
+  EXPECT_EQ(u2b, fresh_trial(op, X2b, 0.1));
+  // Step 3: committed at X2b after the trial there, then trials with a new dt.
+  op.commit(X2b, 0.1);
+  ASSERT_EQ(op.fluid_state().step, 2);
+  EXPECT_EQ(trial(op, X1b, 0.08), fresh_trial(op, X1b, 0.08));
+  EXPECT_EQ(trial(op, X2, 0.08), fresh_trial(op, X2, 0.08));
 }
 
 TEST(ImmersedBoundaryOperator, TheLowestNumberedFailingMembraneIsNamed) {

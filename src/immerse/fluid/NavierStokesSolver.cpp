@@ -24,51 +24,54 @@ void ensure_shape(Array3& a, const Grid& g) {
   if (a.shape() != g.cell_shape()) a = Array3(g.n(0), g.n(1), g.n(2));
 }
 
-/// The constants of (9)–(10) at the faces of one component.
-struct RhsCoefficients {
-  double dt_rho, rho, half_mu;  // Δt/ρ, ρ, μ/2
-  double w_now, w_old;          // Adams–Bashforth weights (10)
-  double fb;                    // body force
+/// The constants of (9)–(10) in the explicit terms.
+struct ExplicitCoefficients {
+  double rho, half_mu;  // ρ, μ/2
+  double w_now, w_old;  // Adams–Bashforth weights (10)
 };
 
-/// Right-hand side of (9) at one face, with the implicit half of the viscous term on the left (lap: ∇_h² u^n
-/// including the wall values, which so move to the right) and A^{n+1/2} by (10) (adv_old unused on the first step).
-inline double rhs_face(const RhsCoefficients& c, bool first, double un, double a_now, double adv_old, double lap,
-                       double grad_p, double f) {
+/// The explicit terms of (9) at one face, E = −ρ A^{n+1/2} − G p^{n−1/2} + (μ/2) lap, with the implicit half of the
+/// viscous term on the left (lap: ∇_h² u^n including the wall values, which so move to the right) and A^{n+1/2} by
+/// (10) (adv_old unused on the first step).
+inline double explicit_face(const ExplicitCoefficients& c, bool first, double a_now, double adv_old, double lap,
+                            double grad_p) {
   const double a = first ? a_now : c.w_now * a_now + c.w_old * adv_old;
-  return un + c.dt_rho * (-c.rho * a - grad_p + c.half_mu * lap + f + c.fb);
+  return -c.rho * a - grad_p + c.half_mu * lap;
 }
 
-/// (u·∇_h u)^n (into adv) and the right-hand side of (9) (into rhs) along row (j, k) of component D, i in
-/// [i0, i1) (no wall layer), reading through accessor R.
+/// Right-hand side of (9) at one face from its explicit terms e and the force f (Δt/ρ: dt_rho, body force fb):
+/// u^n + (Δt/ρ)((e + f) + fb), the sums of u^n + (Δt/ρ)(−ρ A − G p + (μ/2) lap + f + fb) in their order.
+inline double rhs_face(double dt_rho, double fb, double un, double e, double f) { return un + dt_rho * (e + f + fb); }
+
+/// (u·∇_h u)^n (into adv) and the explicit terms of (9) (into ex) along row (j, k) of component D, i in [i0, i1)
+/// (no wall layer), reading through accessor R.
 template <int D, bool First, class R>
-void rhs_row(const MacGeom& g, const FluidState& in, const FaceField& force, const RhsCoefficients& c, Array3& adv,
-             Array3& rhs, int j, int k, int i0, int i1) {
+void explicit_row(const MacGeom& g, const FluidState& in, const ExplicitCoefficients& c, Array3& adv, Array3& ex,
+                  int j, int k, int i0, int i1) {
   // Everything the loop reads in locals: the compiler then sees loop-invariant rows and vectorizes.
   const R ru(in.u[D], g, j, k), r0(in.u[0], g, j, k), r1(in.u[1], g, j, k), r2(in.u[2], g, j, k), rp(in.p, g, j, k);
   const std::size_t o = adv.index(0, j, k);
-  const double* const fr = force[D].data() + o;
   const double* const old = First ? nullptr : in.adv[D].data() + o;  // (not read on the first step)
   double* const ar = adv.data() + o;
-  double* const rr = rhs.data() + o;
-  const RhsCoefficients cc = c;
+  double* const er = ex.data() + o;
+  const ExplicitCoefficients cc = c;
   const double inv_h = g.inv_h, inv_h2 = g.inv_h2;
   mac::along_row(i0, i1, g.n[0], g.periodic[0], [&](mac::XIndex x) __attribute__((always_inline)) {
     const int i = x.c;
     const mac::FaceStencil st = mac::gather_row(ru, x);
     const double a_now = mac::advection_row<D>(st, r0, r1, r2, x, inv_h);
     ar[i] = a_now;
-    rr[i] = rhs_face(cc, First, st.centre, a_now, First ? 0.0 : old[i], mac::laplacian(st, inv_h2),
-                     mac::gradient_row<D>(rp, x, inv_h), fr[i]);
+    er[i] = explicit_face(cc, First, a_now, First ? 0.0 : old[i], mac::laplacian(st, inv_h2),
+                          mac::gradient_row<D>(rp, x, inv_h));
   });
 }
 
-/// Writes (u·∇_h u)^n into adv and the right-hand side of (9) into rhs at every unknown of component D: the row
+/// Writes (u·∇_h u)^n into adv and the explicit terms of (9) into ex at every unknown of component D: the row
 /// kernels wherever they apply, the generic kernels in the wall layers.
 template <int D, bool First>
-void build_rhs_t(const MacGeom& g, const FluidState& in, const FaceField& force, const RhsCoefficients& c,
-                 Array3& adv, Array3& rhs) {
-  const Array3 &un = in.u[D], &f = force[D], &p = in.p;
+void build_explicit_t(const MacGeom& g, const FluidState& in, const ExplicitCoefficients& c, Array3& adv,
+                      Array3& ex) {
+  const Array3 &un = in.u[D], &p = in.p;
   for_each_split(
       g, face_box(g, D), interior_face_box(g, D),
       [&](int i, int j, int k) {
@@ -77,24 +80,42 @@ void build_rhs_t(const MacGeom& g, const FluidState& in, const FaceField& force,
         const double a_now = mac::advection_face(in.u, g, D, q, st);
         adv(i, j, k) = a_now;
         const double lap = mac::laplacian(st, g) + mac::wall_source_face(g, D, q);
-        rhs(i, j, k) = rhs_face(c, First, un(i, j, k), a_now, First ? 0.0 : in.adv[D](i, j, k), lap,
-                                mac::gradient_face(p, g, D, q), f(i, j, k));
+        ex(i, j, k) = explicit_face(c, First, a_now, First ? 0.0 : in.adv[D](i, j, k), lap,
+                                    mac::gradient_face(p, g, D, q));
       },
       [&](int j, int k, int i0, int i1) {
         if (mac::row_wraps(g, j, k))
-          rhs_row<D, First, mac::WrappedRows>(g, in, force, c, adv, rhs, j, k, i0, i1);
+          explicit_row<D, First, mac::WrappedRows>(g, in, c, adv, ex, j, k, i0, i1);
         else
-          rhs_row<D, First, mac::Strided>(g, in, force, c, adv, rhs, j, k, i0, i1);
+          explicit_row<D, First, mac::Strided>(g, in, c, adv, ex, j, k, i0, i1);
       });
 }
 
 template <int D>
-void build_rhs(const MacGeom& g, const FluidState& in, const FaceField& force, const RhsCoefficients& c, bool first,
-               Array3& adv, Array3& rhs) {
+void build_explicit(const MacGeom& g, const FluidState& in, const ExplicitCoefficients& c, bool first, Array3& adv,
+                    Array3& ex) {
   if (first)
-    build_rhs_t<D, true>(g, in, force, c, adv, rhs);
+    build_explicit_t<D, true>(g, in, c, adv, ex);
   else
-    build_rhs_t<D, false>(g, in, force, c, adv, rhs);
+    build_explicit_t<D, false>(g, in, c, adv, ex);
+}
+
+/// The right-hand side of (9) (into rhs) along row (j, k) of the unknowns of one component, i in [i0, i1), from
+/// u^n, the explicit terms ex and the force f; and the next state's (u·∇_h u)^n (adv, into adv_out).
+void rhs_row(const Array3& un, const Array3& ex, const Array3& f, const Array3& adv, double dt_rho, double fb,
+             Array3& rhs, Array3& adv_out, int j, int k, int i0, int i1) {
+  const std::size_t o = rhs.index(0, j, k);
+  const double* const ur = un.data() + o;
+  const double* const er = ex.data() + o;
+  const double* const fr = f.data() + o;
+  const double* const ar = adv.data() + o;
+  double* const rr = rhs.data() + o;
+  double* const ao = adv_out.data() + o;
+#pragma omp simd
+  for (int i = i0; i < i1; ++i) {
+    rr[i] = rhs_face(dt_rho, fb, ur[i], er[i], fr[i]);
+    ao[i] = ar[i];
+  }
 }
 
 /// D u* (into div) and the right-hand side (ρ/Δt) D u* of (11) (into phi) along row (j, k) of the cells.
@@ -181,31 +202,55 @@ bool NavierStokesSolver::matches_grid(const FaceField& f) const {
 }
 
 void NavierStokesSolver::step(const FluidState& in, const FaceField& force, double dt, FluidState& out) {
-  if (!(std::isfinite(dt) && dt > 0)) require(false, "fluid.dt", dt, "> 0");  // (no strings built when valid)
   if (&in == &out) throw std::invalid_argument("NavierStokesSolver::step: `in` and `out` must be different states");
-  if (!matches_grid(in.u) || !matches_grid(force) || in.p.shape() != grid_.cell_shape() ||
-      (in.step > 0 && !matches_grid(in.adv)))
-    throw std::invalid_argument("NavierStokesSolver::step: state or force does not match the grid");
+  prepare(in, dt, prepared_);
+  step(prepared_, force, out);
+}
+
+void NavierStokesSolver::prepare(const FluidState& in, double dt, PreparedStep& prepared) const {
+  if (!(std::isfinite(dt) && dt > 0)) require(false, "fluid.dt", dt, "> 0");  // (no strings built when valid)
+  if (!matches_grid(in.u) || in.p.shape() != grid_.cell_shape() || (in.step > 0 && !matches_grid(in.adv)))
+    throw std::invalid_argument("NavierStokesSolver::prepare: state does not match the grid");
+  prepared.dt_ = 0;  // (not prepared until the end)
+  prepared.u_ = in.u;
+  prepared.p_ = in.p;
+  ensure_shape(prepared.adv_, grid_);
+  ensure_shape(prepared.explicit_, grid_);
+
+  const MacGeom& g = geom_;
+  // (10): Adams–Bashforth weights for a variable step; forward Euler on the first step.
+  const bool first = in.step == 0 || in.dt_prev <= 0;
+  const double r = first ? 0.0 : dt / in.dt_prev;
+  const ExplicitCoefficients coef{params_.rho, 0.5 * params_.mu, 1.0 + 0.5 * r, -0.5 * r};
+  build_explicit<0>(g, in, coef, first, prepared.adv_[0], prepared.explicit_[0]);
+  build_explicit<1>(g, in, coef, first, prepared.adv_[1], prepared.explicit_[1]);
+  build_explicit<2>(g, in, coef, first, prepared.adv_[2], prepared.explicit_[2]);
+
+  prepared.step_ = in.step;
+  prepared.time_ = in.time;
+  prepared.dt_ = dt;
+}
+
+void NavierStokesSolver::step(const PreparedStep& prepared, const FaceField& force, FluidState& out) {
+  if (!(prepared.dt_ > 0)) throw std::invalid_argument("NavierStokesSolver::step: the step was not prepared");
+  if (!matches_grid(force) || !matches_grid(prepared.explicit_))
+    throw std::invalid_argument("NavierStokesSolver::step: prepared step or force does not match the grid");
   ensure_shape(out.u, grid_);
   ensure_shape(out.adv, grid_);
   ensure_shape(out.p, grid_);
 
   const MacGeom& g = geom_;
-  const double rho = params_.rho, mu = params_.mu;
+  const double dt = prepared.dt_, rho = params_.rho, mu = params_.mu;
   const double c = mu * dt / (2.0 * rho);  // (I − c ∇_h²) u* = rhs
-  // (10): Adams–Bashforth weights for a variable step; forward Euler on the first step.
-  const bool first = in.step == 0 || in.dt_prev <= 0;
-  const double r = first ? 0.0 : dt / in.dt_prev;
-  const RhsCoefficients coef{dt / rho, rho, 0.5 * mu, 1.0 + 0.5 * r, -0.5 * r, 0.0};
+  const double dt_rho = dt / rho;
 
+  // (9), with (u·∇_h u)^n into the new state on the way.
   for (int d = 0; d < 3; ++d) {
-    RhsCoefficients cd = coef;
-    cd.fb = params_.body_force[d];
-    switch (d) {
-      case 0: build_rhs<0>(g, in, force, cd, first, out.adv[0], ustar_[0]); break;
-      case 1: build_rhs<1>(g, in, force, cd, first, out.adv[1], ustar_[1]); break;
-      default: build_rhs<2>(g, in, force, cd, first, out.adv[2], ustar_[2]); break;
-    }
+    const double fb = params_.body_force[d];
+    for_each_row(g, face_box(g, d), [&](int j, int k, int i0, int i1) {
+      rhs_row(prepared.u_[d], prepared.explicit_[d], force[d], prepared.adv_[d], dt_rho, fb, ustar_[d], out.adv[d],
+              j, k, i0, i1);
+    });
     solvers_[d]->solve(ustar_[d], 1.0, -c);
   }
   apply_wall_values(ustar_);
@@ -221,14 +266,13 @@ void NavierStokesSolver::step(const FluidState& in, const FaceField& force, doub
   solvers_[3]->solve(phi_, 0.0, 1.0);
 
   // (12) and (13).
-  const double dt_rho = coef.dt_rho;
   project<0>(g, ustar_[0], phi_, out.u[0], dt_rho);
   project<1>(g, ustar_[1], phi_, out.u[1], dt_rho);
   project<2>(g, ustar_[2], phi_, out.u[2], dt_rho);
   apply_wall_values(out.u);
   {
-    const double half_mu = coef.half_mu;
-    const double* p0 = in.p.data();
+    const double half_mu = 0.5 * mu;
+    const double* p0 = prepared.p_.data();
     const double* ph = phi_.data();
     const double* dv = div_.data();
     double* p1 = out.p.data();
@@ -238,8 +282,8 @@ void NavierStokesSolver::step(const FluidState& in, const FaceField& force, doub
   }
 
   out.dt_prev = dt;
-  out.step = in.step + 1;
-  out.time = in.time + dt;
+  out.step = prepared.step_ + 1;
+  out.time = prepared.time_ + dt;
 }
 
 }  // namespace immerse

@@ -15,6 +15,13 @@
 // (9) is three Helmholtz problems (I − (μΔt/2ρ) ∇_h²) u*_d = rhs_d and (11) one Poisson problem; all four are
 // solved directly by FastSolver. Since G is applied only at interior faces and ∇_h² for φ is D G with G φ = 0 on
 // walls, D u^{n+1} = 0 to round-off.
+//
+// A step is split in two: prepare() does the part that depends on the state and Δt alone, the explicit terms
+// E = −ρ A^{n+1/2} − G p^{n−1/2} + (μ/2) ∇_h² u^n of (9) and (10); step(prepared, F) adds the force,
+// rhs = u^n + (Δt/ρ)((E + F) + f_body), and does the solves (9), (11) and (12)–(13). The trials of an implicit
+// step are fluid steps from the same state with the same Δt under different forces: they share one prepare().
+// The sums are those of the whole expression u^n + (Δt/ρ)(−ρ A − G p + (μ/2) ∇_h² u^n + F + f_body) taken left
+// to right, so the split step is bitwise the unsplit one.
 #include <array>
 #include <memory>
 
@@ -24,6 +31,28 @@
 #include "immerse/fluid/MacGeom.hpp"
 
 namespace immerse {
+
+/// The force-independent part of one step from a state (u^n, p^{n−1/2}, (u·∇_h u)^{n−1}) with a Δt, made by
+/// NavierStokesSolver::prepare: step() finishes it under any number of forces. It holds copies of u^n and
+/// p^{n−1/2}, so it does not refer to the state it was prepared from (which may change afterwards).
+class PreparedStep {
+ public:
+  /// Whether this was prepared from a state at the step and time of `s` with this dt (never, before the first
+  /// prepare()). Compares the step counter and the time only, not the fields.
+  bool prepared_for(const FluidState& s, double dt) const {
+    return dt_ > 0 && dt == dt_ && s.step == step_ && s.time == time_;
+  }
+
+ private:
+  friend class NavierStokesSolver;
+  FaceField u_;         ///< u^n
+  Array3 p_;            ///< p^{n−1/2}
+  FaceField adv_;       ///< (u·∇_h u)^n at the unknowns: the adv of the next state
+  FaceField explicit_;  ///< E = −ρ A^{n+1/2} − G p^{n−1/2} + (μ/2) ∇_h² u^n (wall sources included) at the unknowns
+  double dt_ = 0;       ///< Δt (0: not prepared)
+  long step_ = 0;       ///< step and time of the state
+  double time_ = 0;
+};
 
 class NavierStokesSolver {
  public:
@@ -41,7 +70,17 @@ class NavierStokesSolver {
   /// Writes into `out` the state one step of size dt after `in` under the force `force` (F^{n+1/2} on the
   /// velocity faces; its wall faces are ignored). Pure: `in` is only read; `out` must be a different object
   /// (it is sized on first use, then reused without allocation). Not reentrant: uses internal scratch.
+  /// The same as prepare(in, dt, p) then step(p, force, out), bitwise.
   void step(const FluidState& in, const FaceField& force, double dt, FluidState& out);
+
+  /// Computes into `prepared` the part of the step of size dt after `in` that does not depend on the force: A^{n+1/2}
+  /// by (10) and the explicit terms of (9) (`prepared` is sized on first use, then reused without allocation).
+  void prepare(const FluidState& in, double dt, PreparedStep& prepared) const;
+
+  /// Writes into `out` the state one step after the state `prepared` was made from, under the force `force` (as
+  /// step(in, force, dt, out)); `prepared` is only read, so any number of forces may follow one prepare().
+  /// Not reentrant: uses internal scratch.
+  void step(const PreparedStep& prepared, const FaceField& force, FluidState& out);
 
   /// Writes the normal wall velocity into the wall faces of u (the boundary condition (3)).
   void apply_wall_values(FaceField& u) const;
@@ -56,9 +95,10 @@ class NavierStokesSolver {
   bool matches_grid(const FaceField& f) const;
 
   std::array<std::unique_ptr<FastSolver>, 4> solvers_;
-  FaceField ustar_;  // u*, then u^{n+1}
-  Array3 div_;       // D u*
-  Array3 phi_;       // pressure increment φ^{n+1}
+  PreparedStep prepared_;  // for step(in, force, dt, out)
+  FaceField ustar_;        // u*, then u^{n+1}
+  Array3 div_;             // D u*
+  Array3 phi_;             // pressure increment φ^{n+1}
 };
 
 }  // namespace immerse

@@ -3,13 +3,15 @@
 //
 //   f(X)      membrane forces at the nodes           ElasticMembrane::compute_force  (§2.3, eq. 42 or -dE/dX)
 //   S(X) f    spread to the MAC faces                 IBCoupler::spread_force          (eq. 6)
-//   u^{n+1}   one projection step driven by F^{n+1/2}  NavierStokesSolver::step        (eqs. 9-13)
+//   u^{n+1}   one projection step driven by F^{n+1/2}  NavierStokesSolver::prepare, step (eqs. 9-13)
 //   J(X) u    interpolated back to the nodes          IBCoupler::interpolate_velocity  (eq. 14)
 //
 // with F^{n+1/2} = (1 - theta) S(X^n) f(X^n) + theta S(Xf) f(Xf); S(X^n) f(X^n) is taken over from the last trial
 // when that was driven by X^{n+1} (as an implicit step's is), else computed once, when a trial with theta < 1
 // first needs it. The committed fluid state is never modified by trial steps; commit() swaps the last trial in, and
-// takes its node velocity J(X^{n+1}) u^{n+1} over when that trial was driven and interpolated at X^{n+1}.
+// takes its node velocity J(X^{n+1}) u^{n+1} over when that trial was driven and interpolated at X^{n+1}. The part
+// of the fluid step that does not depend on the force is prepared once from the committed state for the trials'
+// dt, and shared by all the trials with that dt until commit().
 // All membranes' nodes are concatenated in one array; errors name the membrane and its local node or element.
 #include <algorithm>
 #include <span>
@@ -74,6 +76,13 @@ class ImmersedBoundaryOperator final : public CoupledOperator {
   std::vector<std::size_t> offset_;  ///< first node of membrane m in the concatenated arrays
   std::vector<Vec3> X_, U_;          ///< committed positions and node velocities
   FluidState committed_, trial_;
+  /// The force-independent part of a fluid step from committed_ (NavierStokesSolver::prepare), reused by the
+  /// trials while prepared_valid_ and prepared_for(committed_, dt). The flag is cleared wherever committed_
+  /// changes (commit(); the constructor starts without); the key catches a new dt (a retried step) and, as a
+  /// second guard, a state at another step or time. A flag and a key rather than a comparison of the fields,
+  /// which would read the whole state at every trial.
+  PreparedStep prepared_;
+  bool prepared_valid_ = false;
   FaceField force_start_;       ///< S(X^n) f(X^n), when start_valid_
   bool start_valid_ = true;
   FaceField force_;             ///< S(Xf) f(Xf) of the last trial
