@@ -24,54 +24,80 @@ void ensure_shape(Array3& a, const Grid& g) {
   if (a.shape() != g.cell_shape()) a = Array3(g.n(0), g.n(1), g.n(2));
 }
 
-/// The constants of (9)–(10) in the explicit terms.
-struct ExplicitCoefficients {
-  double rho, half_mu;  // ρ, μ/2
-  double w_now, w_old;  // Adams–Bashforth weights (10)
+/// The constants of (9)–(10) at the faces of one component.
+struct RhsCoefficients {
+  double dt_rho, rho, half_mu;  // Δt/ρ, ρ, μ/2
+  double w_now, w_old;          // Adams–Bashforth weights (10)
+  double fb;                    // body force
 };
+
+/// Whether the step after `in` is the first one (forward Euler in (10)).
+bool first_step(const FluidState& in) { return in.step == 0 || in.dt_prev <= 0; }
+
+/// The constants of (9)–(10) for component d of the step of size dt after `in`.
+RhsCoefficients rhs_coefficients(const FluidParams& prm, const FluidState& in, double dt, int d) {
+  const double r = first_step(in) ? 0.0 : dt / in.dt_prev;  // (10): AB2 for a variable step
+  return {dt / prm.rho, prm.rho, 0.5 * prm.mu, 1.0 + 0.5 * r, -0.5 * r, prm.body_force[d]};
+}
 
 /// The explicit terms of (9) at one face, E = −ρ A^{n+1/2} − G p^{n−1/2} + (μ/2) lap, with the implicit half of the
 /// viscous term on the left (lap: ∇_h² u^n including the wall values, which so move to the right) and A^{n+1/2} by
 /// (10) (adv_old unused on the first step).
-inline double explicit_face(const ExplicitCoefficients& c, bool first, double a_now, double adv_old, double lap,
+inline double explicit_face(const RhsCoefficients& c, bool first, double a_now, double adv_old, double lap,
                             double grad_p) {
   const double a = first ? a_now : c.w_now * a_now + c.w_old * adv_old;
   return -c.rho * a - grad_p + c.half_mu * lap;
 }
 
-/// Right-hand side of (9) at one face from its explicit terms e and the force f (Δt/ρ: dt_rho, body force fb):
-/// u^n + (Δt/ρ)((e + f) + fb), the sums of u^n + (Δt/ρ)(−ρ A − G p + (μ/2) lap + f + fb) in their order.
-inline double rhs_face(double dt_rho, double fb, double un, double e, double f) { return un + dt_rho * (e + f + fb); }
+/// Right-hand side of (9) at one face from u^n, its explicit terms e and the force f: u^n + (Δt/ρ)((e + f) + f_body),
+/// the sums of u^n + (Δt/ρ)(−ρ A − G p + (μ/2) lap + f + f_body) in their order.
+inline double rhs_face(const RhsCoefficients& c, double un, double e, double f) {
+  return un + c.dt_rho * (e + f + c.fb);
+}
 
-/// (u·∇_h u)^n (into adv) and the explicit terms of (9) (into ex) along row (j, k) of component D, i in [i0, i1)
-/// (no wall layer), reading through accessor R.
-template <int D, bool First, class R>
-void explicit_row(const MacGeom& g, const FluidState& in, const ExplicitCoefficients& c, Array3& adv, Array3& ex,
-                  int j, int k, int i0, int i1) {
-  // Everything the loop reads in locals: the compiler then sees loop-invariant rows and vectorizes.
+/// What the kernels below write at a face besides (u·∇_h u)^n: the explicit terms e (prepare), or, WithForce, the
+/// right-hand side of (9) under the force f[n] (the fused step).
+template <bool WithForce>
+inline double result_face(const RhsCoefficients& c, double un, double e, const double* f, std::size_t n) {
+  if constexpr (WithForce)
+    return rhs_face(c, un, e, f[n]);
+  else
+    return e;
+}
+
+/// (u·∇_h u)^n (into adv) and the explicit terms of (9), or WithForce the right-hand side under `force` (into res),
+/// along row (j, k) of component D, i in [i0, i1) (no wall layer), reading through accessor R.
+template <int D, bool First, bool WithForce, class R>
+__attribute__((flatten)) void explicit_row(const MacGeom& g, const FluidState& in, const Array3* force, const RhsCoefficients& c, Array3& adv,
+                  Array3& res, int j, int k, int i0, int i1) {
+  // Everything the loop reads in locals: the compiler then sees loop-invariant rows and vectorizes. Flattened: with
+  // the many instances of this kernel GCC would leave the stencil functions out of line, and the loop scalar.
   const R ru(in.u[D], g, j, k), r0(in.u[0], g, j, k), r1(in.u[1], g, j, k), r2(in.u[2], g, j, k), rp(in.p, g, j, k);
   const std::size_t o = adv.index(0, j, k);
+  const double* const fr = WithForce ? force->data() + o : nullptr;
   const double* const old = First ? nullptr : in.adv[D].data() + o;  // (not read on the first step)
   double* const ar = adv.data() + o;
-  double* const er = ex.data() + o;
-  const ExplicitCoefficients cc = c;
+  double* const rr = res.data() + o;
+  const RhsCoefficients cc = c;
   const double inv_h = g.inv_h, inv_h2 = g.inv_h2;
   mac::along_row(i0, i1, g.n[0], g.periodic[0], [&](mac::XIndex x) __attribute__((always_inline)) {
     const int i = x.c;
     const mac::FaceStencil st = mac::gather_row(ru, x);
     const double a_now = mac::advection_row<D>(st, r0, r1, r2, x, inv_h);
     ar[i] = a_now;
-    er[i] = explicit_face(cc, First, a_now, First ? 0.0 : old[i], mac::laplacian(st, inv_h2),
-                          mac::gradient_row<D>(rp, x, inv_h));
+    const double e = explicit_face(cc, First, a_now, First ? 0.0 : old[i], mac::laplacian(st, inv_h2),
+                                   mac::gradient_row<D>(rp, x, inv_h));
+    rr[i] = result_face<WithForce>(cc, st.centre, e, fr, i);
   });
 }
 
-/// Writes (u·∇_h u)^n into adv and the explicit terms of (9) into ex at every unknown of component D: the row
-/// kernels wherever they apply, the generic kernels in the wall layers.
-template <int D, bool First>
-void build_explicit_t(const MacGeom& g, const FluidState& in, const ExplicitCoefficients& c, Array3& adv,
-                      Array3& ex) {
+/// Writes (u·∇_h u)^n into adv and the explicit terms of (9), or WithForce the right-hand side under `force`, into
+/// res at every unknown of component D: the row kernels wherever they apply, the generic kernels in the wall layers.
+template <int D, bool First, bool WithForce>
+void build_t(const MacGeom& g, const FluidState& in, const Array3* force, const RhsCoefficients& c, Array3& adv,
+             Array3& res) {
   const Array3 &un = in.u[D], &p = in.p;
+  const double* const f = WithForce ? force->data() : nullptr;
   for_each_split(
       g, face_box(g, D), interior_face_box(g, D),
       [&](int i, int j, int k) {
@@ -80,29 +106,40 @@ void build_explicit_t(const MacGeom& g, const FluidState& in, const ExplicitCoef
         const double a_now = mac::advection_face(in.u, g, D, q, st);
         adv(i, j, k) = a_now;
         const double lap = mac::laplacian(st, g) + mac::wall_source_face(g, D, q);
-        ex(i, j, k) = explicit_face(c, First, a_now, First ? 0.0 : in.adv[D](i, j, k), lap,
-                                    mac::gradient_face(p, g, D, q));
+        const double e = explicit_face(c, First, a_now, First ? 0.0 : in.adv[D](i, j, k), lap,
+                                       mac::gradient_face(p, g, D, q));
+        res(i, j, k) = result_face<WithForce>(c, un(i, j, k), e, f, un.index(i, j, k));
       },
       [&](int j, int k, int i0, int i1) {
         if (mac::row_wraps(g, j, k))
-          explicit_row<D, First, mac::WrappedRows>(g, in, c, adv, ex, j, k, i0, i1);
+          explicit_row<D, First, WithForce, mac::WrappedRows>(g, in, force, c, adv, res, j, k, i0, i1);
         else
-          explicit_row<D, First, mac::Strided>(g, in, c, adv, ex, j, k, i0, i1);
+          explicit_row<D, First, WithForce, mac::Strided>(g, in, force, c, adv, res, j, k, i0, i1);
       });
 }
 
-template <int D>
-void build_explicit(const MacGeom& g, const FluidState& in, const ExplicitCoefficients& c, bool first, Array3& adv,
-                    Array3& ex) {
-  if (first)
-    build_explicit_t<D, true>(g, in, c, adv, ex);
+/// build_t for component d (force: its component d, WithForce).
+template <bool WithForce>
+void build(const MacGeom& g, int d, const FluidState& in, const Array3* force, const RhsCoefficients& c, Array3& adv,
+           Array3& res) {
+  const bool first = first_step(in);
+  const auto run = [&]<int D>() {
+    if (first)
+      build_t<D, true, WithForce>(g, in, force, c, adv, res);
+    else
+      build_t<D, false, WithForce>(g, in, force, c, adv, res);
+  };
+  if (d == 0)
+    run.template operator()<0>();
+  else if (d == 1)
+    run.template operator()<1>();
   else
-    build_explicit_t<D, false>(g, in, c, adv, ex);
+    run.template operator()<2>();
 }
 
 /// The right-hand side of (9) (into rhs) along row (j, k) of the unknowns of one component, i in [i0, i1), from
 /// u^n, the explicit terms ex and the force f; and the next state's (u·∇_h u)^n (adv, into adv_out).
-void rhs_row(const Array3& un, const Array3& ex, const Array3& f, const Array3& adv, double dt_rho, double fb,
+void rhs_row(const Array3& un, const Array3& ex, const Array3& f, const Array3& adv, const RhsCoefficients& c,
              Array3& rhs, Array3& adv_out, int j, int k, int i0, int i1) {
   const std::size_t o = rhs.index(0, j, k);
   const double* const ur = un.data() + o;
@@ -111,9 +148,10 @@ void rhs_row(const Array3& un, const Array3& ex, const Array3& f, const Array3& 
   const double* const ar = adv.data() + o;
   double* const rr = rhs.data() + o;
   double* const ao = adv_out.data() + o;
+  const RhsCoefficients cc = c;
 #pragma omp simd
   for (int i = i0; i < i1; ++i) {
-    rr[i] = rhs_face(dt_rho, fb, ur[i], er[i], fr[i]);
+    rr[i] = rhs_face(cc, ur[i], er[i], fr[i]);
     ao[i] = ar[i];
   }
 }
@@ -201,56 +239,29 @@ bool NavierStokesSolver::matches_grid(const FaceField& f) const {
   return true;
 }
 
-void NavierStokesSolver::step(const FluidState& in, const FaceField& force, double dt, FluidState& out) {
-  if (&in == &out) throw std::invalid_argument("NavierStokesSolver::step: `in` and `out` must be different states");
-  prepare(in, dt, prepared_);
-  step(prepared_, force, out);
-}
-
-void NavierStokesSolver::prepare(const FluidState& in, double dt, PreparedStep& prepared) const {
+void NavierStokesSolver::check(const FluidState& in, double dt) const {
   if (!(std::isfinite(dt) && dt > 0)) require(false, "fluid.dt", dt, "> 0");  // (no strings built when valid)
   if (!matches_grid(in.u) || in.p.shape() != grid_.cell_shape() || (in.step > 0 && !matches_grid(in.adv)))
-    throw std::invalid_argument("NavierStokesSolver::prepare: state does not match the grid");
-  prepared.dt_ = 0;  // (not prepared until the end)
-  prepared.u_ = in.u;
-  prepared.p_ = in.p;
-  ensure_shape(prepared.adv_, grid_);
-  ensure_shape(prepared.explicit_, grid_);
-
-  const MacGeom& g = geom_;
-  // (10): Adams–Bashforth weights for a variable step; forward Euler on the first step.
-  const bool first = in.step == 0 || in.dt_prev <= 0;
-  const double r = first ? 0.0 : dt / in.dt_prev;
-  const ExplicitCoefficients coef{params_.rho, 0.5 * params_.mu, 1.0 + 0.5 * r, -0.5 * r};
-  build_explicit<0>(g, in, coef, first, prepared.adv_[0], prepared.explicit_[0]);
-  build_explicit<1>(g, in, coef, first, prepared.adv_[1], prepared.explicit_[1]);
-  build_explicit<2>(g, in, coef, first, prepared.adv_[2], prepared.explicit_[2]);
-
-  prepared.step_ = in.step;
-  prepared.time_ = in.time;
-  prepared.dt_ = dt;
+    throw std::invalid_argument("NavierStokesSolver: state does not match the grid");
 }
 
-void NavierStokesSolver::step(const PreparedStep& prepared, const FaceField& force, FluidState& out) {
-  if (!(prepared.dt_ > 0)) throw std::invalid_argument("NavierStokesSolver::step: the step was not prepared");
-  if (!matches_grid(force) || !matches_grid(prepared.explicit_))
-    throw std::invalid_argument("NavierStokesSolver::step: prepared step or force does not match the grid");
+void NavierStokesSolver::check_force(const FaceField& force) const {
+  if (!matches_grid(force)) throw std::invalid_argument("NavierStokesSolver::step: force does not match the grid");
+}
+
+template <class Rhs>
+void NavierStokesSolver::advance(const FluidState& in, double dt, FluidState& out, Rhs&& rhs) {
   ensure_shape(out.u, grid_);
   ensure_shape(out.adv, grid_);
   ensure_shape(out.p, grid_);
 
   const MacGeom& g = geom_;
-  const double dt = prepared.dt_, rho = params_.rho, mu = params_.mu;
+  const double rho = params_.rho, mu = params_.mu;
   const double c = mu * dt / (2.0 * rho);  // (I − c ∇_h²) u* = rhs
   const double dt_rho = dt / rho;
 
-  // (9), with (u·∇_h u)^n into the new state on the way.
   for (int d = 0; d < 3; ++d) {
-    const double fb = params_.body_force[d];
-    for_each_row(g, face_box(g, d), [&](int j, int k, int i0, int i1) {
-      rhs_row(prepared.u_[d], prepared.explicit_[d], force[d], prepared.adv_[d], dt_rho, fb, ustar_[d], out.adv[d],
-              j, k, i0, i1);
-    });
+    rhs(d);
     solvers_[d]->solve(ustar_[d], 1.0, -c);
   }
   apply_wall_values(ustar_);
@@ -272,7 +283,7 @@ void NavierStokesSolver::step(const PreparedStep& prepared, const FaceField& for
   apply_wall_values(out.u);
   {
     const double half_mu = 0.5 * mu;
-    const double* p0 = prepared.p_.data();
+    const double* p0 = in.p.data();
     const double* ph = phi_.data();
     const double* dv = div_.data();
     double* p1 = out.p.data();
@@ -282,8 +293,50 @@ void NavierStokesSolver::step(const PreparedStep& prepared, const FaceField& for
   }
 
   out.dt_prev = dt;
-  out.step = prepared.step_ + 1;
-  out.time = prepared.time_ + dt;
+  out.step = in.step + 1;
+  out.time = in.time + dt;
+}
+
+void NavierStokesSolver::step(const FluidState& in, const FaceField& force, double dt, FluidState& out) {
+  check(in, dt);
+  check_force(force);
+  if (&in == &out) throw std::invalid_argument("NavierStokesSolver::step: `in` and `out` must be different states");
+  // (9) in one pass: (u·∇_h u)^n into the new state, the right-hand side into u*.
+  advance(in, dt, out, [&](int d) {
+    build<true>(geom_, d, in, &force[d], rhs_coefficients(params_, in, dt, d), out.adv[d], ustar_[d]);
+  });
+}
+
+void NavierStokesSolver::prepare(const FluidState& in, double dt, PreparedStep& prepared) const {
+  check(in, dt);
+  prepared.state_ = nullptr;  // (not prepared until the end)
+  ensure_shape(prepared.adv_, grid_);
+  ensure_shape(prepared.explicit_, grid_);
+  for (int d = 0; d < 3; ++d)
+    build<false>(geom_, d, in, nullptr, rhs_coefficients(params_, in, dt, d), prepared.adv_[d],
+                 prepared.explicit_[d]);
+  prepared.state_ = &in;
+  prepared.step_ = in.step;
+  prepared.time_ = in.time;
+  prepared.dt_ = dt;
+}
+
+void NavierStokesSolver::step(const PreparedStep& prepared, const FaceField& force, FluidState& out) {
+  const FluidState* const in = prepared.state_;
+  if (!in) throw std::invalid_argument("NavierStokesSolver::step: the step was not prepared");
+  if (in->step != prepared.step_ || in->time != prepared.time_)
+    throw std::logic_error("NavierStokesSolver::step: the state the step was prepared from has changed");
+  if (in == &out)
+    throw std::invalid_argument("NavierStokesSolver::step: `out` must not be the state the step was prepared from");
+  check_force(force);
+  const double dt = prepared.dt_;
+  // (9) from the prepared explicit terms; their (u·∇_h u)^n into the new state.
+  advance(*in, dt, out, [&](int d) {
+    const RhsCoefficients c = rhs_coefficients(params_, *in, dt, d);
+    for_each_row(geom_, face_box(geom_, d), [&](int j, int k, int i0, int i1) {
+      rhs_row(in->u[d], prepared.explicit_[d], force[d], prepared.adv_[d], c, ustar_[d], out.adv[d], j, k, i0, i1);
+    });
+  });
 }
 
 }  // namespace immerse

@@ -16,12 +16,13 @@
 // solved directly by FastSolver. Since G is applied only at interior faces and ∇_h² for φ is D G with G φ = 0 on
 // walls, D u^{n+1} = 0 to round-off.
 //
-// A step is split in two: prepare() does the part that depends on the state and Δt alone, the explicit terms
+// step(in, F, Δt) builds the right-hand side of (9) in one pass over the faces. A step may also be split in two:
+// prepare() does the part that depends on the state and Δt alone, the explicit terms
 // E = −ρ A^{n+1/2} − G p^{n−1/2} + (μ/2) ∇_h² u^n of (9) and (10); step(prepared, F) adds the force,
 // rhs = u^n + (Δt/ρ)((E + F) + f_body), and does the solves (9), (11) and (12)–(13). The trials of an implicit
 // step are fluid steps from the same state with the same Δt under different forces: they share one prepare().
-// The sums are those of the whole expression u^n + (Δt/ρ)(−ρ A − G p + (μ/2) ∇_h² u^n + F + f_body) taken left
-// to right, so the split step is bitwise the unsplit one.
+// Both paths evaluate the same pointwise functions, the sums of u^n + (Δt/ρ)(−ρ A − G p + (μ/2) ∇_h² u^n + F +
+// f_body) taken left to right, so the split step is bitwise the one-pass one.
 #include <array>
 #include <memory>
 
@@ -33,24 +34,25 @@
 namespace immerse {
 
 /// The force-independent part of one step from a state (u^n, p^{n−1/2}, (u·∇_h u)^{n−1}) with a Δt, made by
-/// NavierStokesSolver::prepare: step() finishes it under any number of forces. It holds copies of u^n and
-/// p^{n−1/2}, so it does not refer to the state it was prepared from (which may change afterwards).
+/// NavierStokesSolver::prepare: step() finishes it under any number of forces. It refers to the state it was
+/// prepared from (reading u^n and p^{n−1/2} there) and is valid while that state is unchanged and alive; step()
+/// checks that the state still has the step counter and time it was prepared at (std::logic_error otherwise), which
+/// catches a state advanced in place but not other changes to its fields.
 class PreparedStep {
  public:
-  /// Whether this was prepared from a state at the step and time of `s` with this dt (never, before the first
-  /// prepare()). Compares the step counter and the time only, not the fields.
+  /// Whether this was prepared from the object `s`, at its step and time, with this dt (never, before the first
+  /// prepare()). Compares the address, step counter and time, not the fields.
   bool prepared_for(const FluidState& s, double dt) const {
-    return dt_ > 0 && dt == dt_ && s.step == step_ && s.time == time_;
+    return state_ == &s && dt == dt_ && s.step == step_ && s.time == time_;
   }
 
  private:
   friend class NavierStokesSolver;
-  FaceField u_;         ///< u^n
-  Array3 p_;            ///< p^{n−1/2}
-  FaceField adv_;       ///< (u·∇_h u)^n at the unknowns: the adv of the next state
+  const FluidState* state_ = nullptr;  ///< the state prepared from (null: not prepared)
+  FaceField adv_;                      ///< (u·∇_h u)^n at the unknowns: the adv of the next state
   FaceField explicit_;  ///< E = −ρ A^{n+1/2} − G p^{n−1/2} + (μ/2) ∇_h² u^n (wall sources included) at the unknowns
-  double dt_ = 0;       ///< Δt (0: not prepared)
-  long step_ = 0;       ///< step and time of the state
+  double dt_ = 0;       ///< Δt
+  long step_ = 0;       ///< step and time of the state when prepared
   double time_ = 0;
 };
 
@@ -70,16 +72,18 @@ class NavierStokesSolver {
   /// Writes into `out` the state one step of size dt after `in` under the force `force` (F^{n+1/2} on the
   /// velocity faces; its wall faces are ignored). Pure: `in` is only read; `out` must be a different object
   /// (it is sized on first use, then reused without allocation). Not reentrant: uses internal scratch.
-  /// The same as prepare(in, dt, p) then step(p, force, out), bitwise.
+  /// Bitwise the same as prepare(in, dt, p) then step(p, force, out), in one pass over the faces for (9).
   void step(const FluidState& in, const FaceField& force, double dt, FluidState& out);
 
   /// Computes into `prepared` the part of the step of size dt after `in` that does not depend on the force: A^{n+1/2}
   /// by (10) and the explicit terms of (9) (`prepared` is sized on first use, then reused without allocation).
+  /// `prepared` refers to `in` afterwards: valid while `in` is unchanged and alive.
   void prepare(const FluidState& in, double dt, PreparedStep& prepared) const;
 
   /// Writes into `out` the state one step after the state `prepared` was made from, under the force `force` (as
-  /// step(in, force, dt, out)); `prepared` is only read, so any number of forces may follow one prepare().
-  /// Not reentrant: uses internal scratch.
+  /// step(in, force, dt, out)); `prepared` and its state are only read, so any number of forces may follow one
+  /// prepare(). `out` must not be the state prepared from (std::invalid_argument); that state must still have its
+  /// step counter and time of prepare() (std::logic_error otherwise). Not reentrant: uses internal scratch.
   void step(const PreparedStep& prepared, const FaceField& force, FluidState& out);
 
   /// Writes the normal wall velocity into the wall faces of u (the boundary condition (3)).
@@ -93,12 +97,17 @@ class NavierStokesSolver {
   FluidParams params_;
   MacGeom geom_;
   bool matches_grid(const FaceField& f) const;
+  void check(const FluidState& in, double dt) const;  // dt > 0 (InputError), `in` on the grid
+  void check_force(const FaceField& force) const;
+  /// The step of size dt after `in` into `out`, rhs(d) writing the right-hand side of (9) for component d into u*
+  /// and (u·∇_h u)^n into out.adv[d]: the solves (9), (11) and (12)–(13).
+  template <class Rhs>
+  void advance(const FluidState& in, double dt, FluidState& out, Rhs&& rhs);
 
   std::array<std::unique_ptr<FastSolver>, 4> solvers_;
-  PreparedStep prepared_;  // for step(in, force, dt, out)
-  FaceField ustar_;        // u*, then u^{n+1}
-  Array3 div_;             // D u*
-  Array3 phi_;             // pressure increment φ^{n+1}
+  FaceField ustar_;  // u*, then u^{n+1}
+  Array3 div_;       // D u*
+  Array3 phi_;       // pressure increment φ^{n+1}
 };
 
 }  // namespace immerse

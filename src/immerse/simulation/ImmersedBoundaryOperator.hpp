@@ -79,8 +79,9 @@ class ImmersedBoundaryOperator final : public CoupledOperator {
   /// The force-independent part of a fluid step from committed_ (NavierStokesSolver::prepare), reused by the
   /// trials while prepared_valid_ and prepared_for(committed_, dt). The flag is cleared wherever committed_
   /// changes (commit(); the constructor starts without); the key catches a new dt (a retried step) and, as a
-  /// second guard, a state at another step or time. A flag and a key rather than a comparison of the fields,
-  /// which would read the whole state at every trial.
+  /// second guard, a state at another step or time; it refers to committed_ by address, so a copied or moved
+  /// operator prepares anew. A flag and a key rather than a comparison of the fields, which would read the whole
+  /// state at every trial.
   PreparedStep prepared_;
   bool prepared_valid_ = false;
   FaceField force_start_;       ///< S(X^n) f(X^n), when start_valid_
