@@ -68,8 +68,9 @@ inline double result_face(const RhsCoefficients& c, double un, double e, const d
 /// (u·∇_h u)^n (into adv) and the explicit terms of (9), or WithForce the right-hand side under `force` (into res),
 /// along row (j, k) of component D, i in [i0, i1) (no wall layer), reading through accessor R.
 template <int D, bool First, bool WithForce, class R>
-__attribute__((flatten)) void explicit_row(const MacGeom& g, const FluidState& in, const Array3* force, const RhsCoefficients& c, Array3& adv,
-                  Array3& res, int j, int k, int i0, int i1) {
+__attribute__((flatten)) void explicit_row(const MacGeom& g, const FluidState& in, const Array3* force,
+                                          const RhsCoefficients& c, Array3& adv, Array3& res, int j, int k, int i0,
+                                          int i1) {
   // Everything the loop reads in locals: the compiler then sees loop-invariant rows and vectorizes. Flattened: with
   // the many instances of this kernel GCC would leave the stencil functions out of line, and the loop scalar.
   const R ru(in.u[D], g, j, k), r0(in.u[0], g, j, k), r1(in.u[1], g, j, k), r2(in.u[2], g, j, k), rp(in.p, g, j, k);
