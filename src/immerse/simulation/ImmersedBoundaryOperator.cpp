@@ -111,11 +111,7 @@ void ImmersedBoundaryOperator::trial_velocity(std::span<const double> Xf, double
         for (std::size_t i = 0; i < a.size(); ++i) a[i] = theta * b[i] + (1.0 - theta) * c[i];
       }
     }
-    if (!prepared_valid_ || !prepared_.prepared_for(committed_, dt)) {
-      prepared_valid_ = false;  // (until prepare() returns)
-      fluid_.prepare(committed_, dt, prepared_);
-      prepared_valid_ = true;
-    }
+    if (!prepared_.prepared_for(committed_, dt)) fluid_.prepare(committed_, dt, prepared_);
     fluid_.step(prepared_, theta < 1.0 ? mixed_ : force_, trial_);
   });
   ++solves_;
@@ -138,7 +134,6 @@ void ImmersedBoundaryOperator::committed_velocity(std::span<const double> Xi, st
 
 void ImmersedBoundaryOperator::commit(std::span<const double> X, double) {
   std::swap(committed_, trial_);
-  prepared_valid_ = false;
   const auto Xn = nodes(X);
   std::copy(Xn.begin(), Xn.end(), X_.begin());
   // A trial interpolated at the positions that drove it, X^{n+1}, has J(X^{n+1}) u^{n+1} already.

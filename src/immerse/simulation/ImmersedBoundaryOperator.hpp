@@ -77,13 +77,10 @@ class ImmersedBoundaryOperator final : public CoupledOperator {
   std::vector<Vec3> X_, U_;          ///< committed positions and node velocities
   FluidState committed_, trial_;
   /// The force-independent part of a fluid step from committed_ (NavierStokesSolver::prepare), reused by the
-  /// trials while prepared_valid_ and prepared_for(committed_, dt). The flag is cleared wherever committed_
-  /// changes (commit(); the constructor starts without); the key catches a new dt (a retried step) and, as a
-  /// second guard, a state at another step or time; it refers to committed_ by address, so a copied or moved
-  /// operator prepares anew. A flag and a key rather than a comparison of the fields, which would read the whole
-  /// state at every trial.
+  /// trials while prepared_for(committed_, dt): the key (address, step counter and time of the state, dt) changes
+  /// with every commit() (the committed step advances), with a new dt (a retried step) and in a copied or moved
+  /// operator; cheaper than comparing the fields, which would read the whole state at every trial.
   PreparedStep prepared_;
-  bool prepared_valid_ = false;
   FaceField force_start_;       ///< S(X^n) f(X^n), when start_valid_
   bool start_valid_ = true;
   FaceField force_;             ///< S(Xf) f(Xf) of the last trial
