@@ -325,7 +325,7 @@ void NavierStokesSolver::prepare(const FluidState& in, double dt, PreparedStep& 
 void NavierStokesSolver::step(const PreparedStep& prepared, const FaceField& force, FluidState& out) {
   const FluidState* const in = prepared.state_;
   if (!in) throw std::invalid_argument("NavierStokesSolver::step: the step was not prepared");
-  if (in->step != prepared.step_ || in->time != prepared.time_)
+  if (!prepared.prepared_for(*in, prepared.dt_))
     throw std::logic_error("NavierStokesSolver::step: the state the step was prepared from has changed");
   if (in == &out)
     throw std::invalid_argument("NavierStokesSolver::step: `out` must not be the state the step was prepared from");
