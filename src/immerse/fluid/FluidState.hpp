@@ -1,5 +1,7 @@
 #pragma once
 // The committed state of the fluid between two time steps of the projection method (paper eqs. 9–13).
+#include <cstdint>
+
 #include "immerse/core/Array3.hpp"
 #include "immerse/grid/FaceField.hpp"
 
@@ -12,6 +14,9 @@ struct FluidState {
   double dt_prev = 0;  ///< time step that produced u^n (0 before the first step)
   long step = 0;       ///< number of steps taken
   double time = 0;     ///< t^n
+  /// Which prepared step's (u·∇_h u)^n `adv` holds (NavierStokesSolver::step(prepared, …) sets it and then skips
+  /// copying it again into this state; 0: none). Whoever else writes `adv` in place sets it to 0.
+  std::uint64_t adv_of = 0;
 };
 
 }  // namespace immerse

@@ -1,6 +1,7 @@
 #include "immerse/fluid/NavierStokesSolver.hpp"
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <cstddef>
 #include <stdexcept>
@@ -139,7 +140,8 @@ void build(const MacGeom& g, int d, const FluidState& in, const Array3* force, c
 }
 
 /// The right-hand side of (9) (into rhs) along row (j, k) of the unknowns of one component, i in [i0, i1), from
-/// u^n, the explicit terms ex and the force f; and the next state's (u·∇_h u)^n (adv, into adv_out).
+/// u^n, the explicit terms ex and the force f; and, CopyAdv, the next state's (u·∇_h u)^n (adv, into adv_out).
+template <bool CopyAdv>
 void rhs_row(const Array3& un, const Array3& ex, const Array3& f, const Array3& adv, const RhsCoefficients& c,
              Array3& rhs, Array3& adv_out, int j, int k, int i0, int i1) {
   const std::size_t o = rhs.index(0, j, k);
@@ -153,7 +155,7 @@ void rhs_row(const Array3& un, const Array3& ex, const Array3& f, const Array3& 
 #pragma omp simd
   for (int i = i0; i < i1; ++i) {
     rr[i] = rhs_face(cc, ur[i], er[i], fr[i]);
-    ao[i] = ar[i];
+    if constexpr (CopyAdv) ao[i] = ar[i];
   }
 }
 
@@ -186,14 +188,23 @@ void project_row(const MacGeom& g, const Array3& us, const Array3& phi, Array3& 
   });
 }
 
-template <int D>
-void project(const MacGeom& g, const Array3& us, const Array3& phi, Array3& un1, double dt_rho) {
-  for_each_row(g, face_box(g, D), [&](int j, int k, int i0, int i1) {
-    if (mac::row_wraps(g, j, k))
-      project_row<D, mac::WrappedRows>(g, us, phi, un1, j, k, i0, i1, dt_rho);
-    else
-      project_row<D, mac::Strided>(g, us, phi, un1, j, k, i0, i1, dt_rho);
-  });
+/// (12) and (13) along row (j, k) of the cells in one pass (φ read once for the three components): the unknowns of
+/// each component in that row (face_box: a component normal to a wall has none in the wall's first row), then
+/// p^{n+1/2} = p^{n−1/2} + φ − (μ/2) D u* at the cells.
+template <class R>
+void project_and_update_row(const MacGeom& g, const FaceField& us, const Array3& phi, const Array3& div,
+                            const Array3& p0, FluidState& out, int j, int k, double dt_rho, double half_mu) {
+  const int i0 = g.first(0, 0), i1 = g.n[0];
+  project_row<0, R>(g, us[0], phi, out.u[0], j, k, i0, i1, dt_rho);
+  if (j >= g.first(1, 1)) project_row<1, R>(g, us[1], phi, out.u[1], j, k, 0, i1, dt_rho);
+  if (k >= g.first(2, 2)) project_row<2, R>(g, us[2], phi, out.u[2], j, k, 0, i1, dt_rho);
+  const std::size_t o = phi.index(0, j, k);
+  const double* const pr0 = p0.data() + o;
+  const double* const ph = phi.data() + o;
+  const double* const dv = div.data() + o;
+  double* const pr1 = out.p.data() + o;
+#pragma omp simd
+  for (int i = 0; i < i1; ++i) pr1[i] = pr0[i] + ph[i] - half_mu * dv[i];
 }
 
 }  // namespace
@@ -278,20 +289,14 @@ void NavierStokesSolver::advance(const FluidState& in, double dt, FluidState& ou
   solvers_[3]->solve(phi_, 0.0, 1.0);
 
   // (12) and (13).
-  project<0>(g, ustar_[0], phi_, out.u[0], dt_rho);
-  project<1>(g, ustar_[1], phi_, out.u[1], dt_rho);
-  project<2>(g, ustar_[2], phi_, out.u[2], dt_rho);
+  const double half_mu = 0.5 * mu;
+  for_each_row(g, IndexBox{{0, 0, 0}, g.n}, [&](int j, int k, int, int) {
+    if (mac::row_wraps(g, j, k))
+      project_and_update_row<mac::WrappedRows>(g, ustar_, phi_, div_, in.p, out, j, k, dt_rho, half_mu);
+    else
+      project_and_update_row<mac::Strided>(g, ustar_, phi_, div_, in.p, out, j, k, dt_rho, half_mu);
+  });
   apply_wall_values(out.u);
-  {
-    const double half_mu = 0.5 * mu;
-    const double* p0 = in.p.data();
-    const double* ph = phi_.data();
-    const double* dv = div_.data();
-    double* p1 = out.p.data();
-    const long cells = static_cast<long>(out.p.size());
-#pragma omp parallel for simd schedule(static) if (g.threaded())
-    for (long n = 0; n < cells; ++n) p1[n] = p0[n] + ph[n] - half_mu * dv[n];
-  }
 
   out.dt_prev = dt;
   out.step = in.step + 1;
@@ -302,6 +307,7 @@ void NavierStokesSolver::step(const FluidState& in, const FaceField& force, doub
   check(in, dt);
   check_force(force);
   if (&in == &out) throw std::invalid_argument("NavierStokesSolver::step: `in` and `out` must be different states");
+  out.adv_of = 0;
   // (9) in one pass: (u·∇_h u)^n into the new state, the right-hand side into u*.
   advance(in, dt, out, [&](int d) {
     build<true>(geom_, d, in, &force[d], rhs_coefficients(params_, in, dt, d), out.adv[d], ustar_[d]);
@@ -316,7 +322,9 @@ void NavierStokesSolver::prepare(const FluidState& in, double dt, PreparedStep& 
   for (int d = 0; d < 3; ++d)
     build<false>(geom_, d, in, nullptr, rhs_coefficients(params_, in, dt, d), prepared.adv_[d],
                  prepared.explicit_[d]);
+  static std::atomic<std::uint64_t> prepares{0};  // (ids only: results never depend on it)
   prepared.state_ = &in;
+  prepared.id_ = ++prepares;
   prepared.step_ = in.step;
   prepared.time_ = in.time;
   prepared.dt_ = dt;
@@ -331,13 +339,21 @@ void NavierStokesSolver::step(const PreparedStep& prepared, const FaceField& for
     throw std::invalid_argument("NavierStokesSolver::step: `out` must not be the state the step was prepared from");
   check_force(force);
   const double dt = prepared.dt_;
-  // (9) from the prepared explicit terms; their (u·∇_h u)^n into the new state.
+  // (9) from the prepared explicit terms; their (u·∇_h u)^n into the new state unless it holds it already.
+  const bool copy_adv = out.adv_of != prepared.id_ || !matches_grid(out.adv);
+  out.adv_of = 0;
   advance(*in, dt, out, [&](int d) {
     const RhsCoefficients c = rhs_coefficients(params_, *in, dt, d);
     for_each_row(geom_, face_box(geom_, d), [&](int j, int k, int i0, int i1) {
-      rhs_row(in->u[d], prepared.explicit_[d], force[d], prepared.adv_[d], c, ustar_[d], out.adv[d], j, k, i0, i1);
+      if (copy_adv)
+        rhs_row<true>(in->u[d], prepared.explicit_[d], force[d], prepared.adv_[d], c, ustar_[d], out.adv[d], j, k, i0,
+                      i1);
+      else
+        rhs_row<false>(in->u[d], prepared.explicit_[d], force[d], prepared.adv_[d], c, ustar_[d], out.adv[d], j, k,
+                       i0, i1);
     });
   });
+  out.adv_of = prepared.id_;
 }
 
 }  // namespace immerse

@@ -24,6 +24,7 @@
 // Both paths evaluate the same pointwise functions, the sums of u^n + (Δt/ρ)(−ρ A − G p + (μ/2) ∇_h² u^n + F +
 // f_body) taken left to right, so the split step is bitwise the one-pass one.
 #include <array>
+#include <cstdint>
 #include <memory>
 
 #include "immerse/fluid/FastSolver.hpp"
@@ -54,6 +55,7 @@ class PreparedStep {
   double dt_ = 0;       ///< Δt
   long step_ = 0;       ///< step and time of the state when prepared
   double time_ = 0;
+  std::uint64_t id_ = 0;  ///< unique in the process for each prepare() (FluidState::adv_of)
 };
 
 class NavierStokesSolver {
@@ -83,7 +85,9 @@ class NavierStokesSolver {
   /// Writes into `out` the state one step after the state `prepared` was made from, under the force `force` (as
   /// step(in, force, dt, out)); `prepared` and its state are only read, so any number of forces may follow one
   /// prepare(). `out` must not be the state prepared from (std::invalid_argument); that state must still have its
-  /// step counter and time of prepare() (std::logic_error otherwise). Not reentrant: uses internal scratch.
+  /// step counter and time of prepare() (std::logic_error otherwise). (u·∇_h u)^n is copied into out.adv only when
+  /// `out` does not hold it already from an earlier call after the same prepare() (FluidState::adv_of): the trials
+  /// of an implicit step, written into one output state, copy it once. Not reentrant: uses internal scratch.
   void step(const PreparedStep& prepared, const FaceField& force, FluidState& out);
 
   /// Writes the normal wall velocity into the wall faces of u (the boundary condition (3)).
