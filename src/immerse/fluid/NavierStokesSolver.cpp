@@ -194,10 +194,10 @@ void project_row(const MacGeom& g, const Array3& us, const Array3& phi, Array3& 
 template <class R>
 void project_and_update_row(const MacGeom& g, const FaceField& us, const Array3& phi, const Array3& div,
                             const Array3& p0, FluidState& out, int j, int k, double dt_rho, double half_mu) {
-  const int i0 = g.first(0, 0), i1 = g.n[0];
-  project_row<0, R>(g, us[0], phi, out.u[0], j, k, i0, i1, dt_rho);
-  if (j >= g.first(1, 1)) project_row<1, R>(g, us[1], phi, out.u[1], j, k, 0, i1, dt_rho);
-  if (k >= g.first(2, 2)) project_row<2, R>(g, us[2], phi, out.u[2], j, k, 0, i1, dt_rho);
+  const int i1 = g.n[0];
+  project_row<0, R>(g, us[0], phi, out.u[0], j, k, g.first(0, 0), i1, dt_rho);
+  if (j >= g.first(1, 1)) project_row<1, R>(g, us[1], phi, out.u[1], j, k, g.first(1, 0), i1, dt_rho);
+  if (k >= g.first(2, 2)) project_row<2, R>(g, us[2], phi, out.u[2], j, k, g.first(2, 0), i1, dt_rho);
   const std::size_t o = phi.index(0, j, k);
   const double* const pr0 = p0.data() + o;
   const double* const ph = phi.data() + o;
@@ -342,16 +342,18 @@ void NavierStokesSolver::step(const PreparedStep& prepared, const FaceField& for
   // (9) from the prepared explicit terms; their (u·∇_h u)^n into the new state unless it holds it already.
   const bool copy_adv = out.adv_of != prepared.id_ || !matches_grid(out.adv);
   out.adv_of = 0;
-  advance(*in, dt, out, [&](int d) {
+  const auto rhs = [&]<bool CopyAdv>(int d) {
     const RhsCoefficients c = rhs_coefficients(params_, *in, dt, d);
     for_each_row(geom_, face_box(geom_, d), [&](int j, int k, int i0, int i1) {
-      if (copy_adv)
-        rhs_row<true>(in->u[d], prepared.explicit_[d], force[d], prepared.adv_[d], c, ustar_[d], out.adv[d], j, k, i0,
-                      i1);
-      else
-        rhs_row<false>(in->u[d], prepared.explicit_[d], force[d], prepared.adv_[d], c, ustar_[d], out.adv[d], j, k,
-                       i0, i1);
+      rhs_row<CopyAdv>(in->u[d], prepared.explicit_[d], force[d], prepared.adv_[d], c, ustar_[d], out.adv[d], j, k, i0,
+                       i1);
     });
+  };
+  advance(*in, dt, out, [&](int d) {
+    if (copy_adv)
+      rhs.template operator()<true>(d);
+    else
+      rhs.template operator()<false>(d);
   });
   out.adv_of = prepared.id_;
 }
