@@ -210,6 +210,72 @@ class Fragile final : public CoupledOperator {
 };
 }  // namespace
 
+namespace {
+// A coupled problem on which unpreconditioned GMRES cannot make progress: U(X) = u0 - (2 alpha / dt) C (X - X^n)
+// with C the cyclic shift, so that g(X) = (I + alpha C)(X - X^n) - dt u0 and J = I + alpha C. J is normal with
+// eigenvalues 1 + alpha e^{2 pi i k / n} on a circle around the origin for alpha > 1: a polynomial with p(0) = 1 and
+// degree below n cannot be small on all of them (maximum principle), so GMRES's residual stays near its start until
+// its Krylov space is the whole space, n products. For alpha < 1 the circle leaves the origin out and GMRES
+// converges geometrically.
+class CyclicShift final : public CoupledOperator {
+ public:
+  CyclicShift(std::size_t n, double alpha) : X_(n), u0_(n), trial_(n), alpha_(alpha) {
+    for (std::size_t i = 0; i < n; ++i) {
+      X_[i] = 0.01 * static_cast<double>(i);
+      u0_[i] = std::cos(0.7 * static_cast<double>(i * i));
+    }
+  }
+  std::size_t size() const override { return X_.size(); }
+  std::span<const double> positions() const override { return X_; }
+  std::span<const double> node_velocity() const override { return u0_; }
+  double length_scale() const override { return 1.0; }
+  void trial_velocity(std::span<const double> Xf, double, std::span<const double>, double dt,
+                      std::span<double> U) override {
+    ++solves_;
+    const std::size_t n = X_.size();
+    for (std::size_t i = 0; i < n; ++i) {
+      const std::size_t j = (i + n - 1) % n;
+      U[i] = u0_[i] - 2 * alpha_ / dt * (Xf[j] - X_[j]);
+    }
+    trial_.assign(Xf.begin(), Xf.end());
+  }
+  void committed_velocity(std::span<const double>, std::span<double> U) override {
+    std::copy(u0_.begin(), u0_.end(), U.begin());
+  }
+  bool trial_matches(std::span<const double> X) const override { return std::ranges::equal(X, trial_); }
+  void commit(std::span<const double> X, double) override { X_.assign(X.begin(), X.end()); }
+  std::size_t fluid_solves() const override { return solves_; }
+
+ private:
+  std::vector<double> X_, u0_, trial_;
+  double alpha_;
+  std::size_t solves_ = 0;
+};
+}  // namespace
+
+// A Newton system GMRES cannot solve is given up after the stall window (its residual did not halve in 30
+// iterations), not after the 200-iteration limit: the step fails at once with a message that says why, and the
+// adaptive step can halve it. A system it can solve is untouched by the test.
+TEST(Integrators, JfnkGivesUpOnAStalledGmresEarly) {
+  CyclicShift stiff(300, 2.0);
+  auto jfnk = make_integrator("jfnk", {});
+  const auto st = jfnk->step(stiff, 0.1);
+  EXPECT_FALSE(st.converged);
+  EXPECT_NE(st.failure.find("GMRES stalled"), std::string::npos) << st.failure;
+  EXPECT_LE(st.fluid_solves, 35u);  // the first residual and 31 products at most (the limit would take 201)
+
+  CyclicShift mild(300, 0.5);
+  const auto ok = make_integrator("jfnk", {})->step(mild, 0.1);
+  ASSERT_TRUE(ok.converged) << ok.failure;
+  EXPECT_LT(ok.gmres_its, 30);
+  const auto X = mild.positions();
+  for (std::size_t i = 0; i < X.size(); ++i) {  // (I + alpha C)(X - X^n) = dt u0
+    const std::size_t j = (i + X.size() - 1) % X.size();
+    const double Xn_i = 0.01 * static_cast<double>(i), Xn_j = 0.01 * static_cast<double>(j);
+    EXPECT_NEAR((X[i] - Xn_i) + 0.5 * (X[j] - Xn_j), 0.1 * std::cos(0.7 * static_cast<double>(i * i)), 1e-7);
+  }
+}
+
 TEST(AdaptiveStepper, HalvesOnFailureAndGrowsBack) {
   auto toy = make_toy();
   Fragile op(toy, 0.03);

@@ -9,7 +9,9 @@
 // Method::NewtonKrylov ("jfnk", §2.4.3): Newton steps (33)-(34), each solved by unpreconditioned GMRES
 // (relative tolerance 1e-3, §4; it also stops once its residual, the linearized ||g|| after the step, is below
 // 0.9 newton_rtol ||X^(0)||: the Newton test is then met unless the nonlinear and finite-difference terms of the
-// step exceed a tenth of the tolerance; on §4.4 they are about 1 % of it) whose matrix-vector product is the
+// step exceed a tenth of the tolerance; on §4.4 they are about 1 % of it; and it gives up as stalled when its
+// residual has not halved over the last 30 iterations, so that a step too stiff for unpreconditioned GMRES is
+// rejected and halved at once instead of after the iteration limit) whose matrix-vector product is the
 // finite difference (36)
 //   J(X) y ~ (g(X + eps y) - g(X)) / eps,   eps = sqrt((1 + ||X||) eps_mach) / ||y||   (37),
 // which is PETSc's matrix-free Jacobian with the Walker-Pernice parameter (MATMFFD_WP). Full Newton steps.
@@ -48,6 +50,8 @@ class SnesIntegrator final : public MembraneIntegrator {
   static PetscErrorCode form_function(SNES, Vec x, Vec f, void* ctx);
   static PetscErrorCode converged(SNES, PetscInt it, PetscReal xnorm, PetscReal snorm, PetscReal fnorm,
                                   SNESConvergedReason* reason, void* ctx);
+  static PetscErrorCode gmres_converged(KSP ksp, PetscInt it, PetscReal rnorm, KSPConvergedReason* reason,
+                                        void* ctx);
 
   Method method_;
   SolverSettings settings_;
@@ -65,6 +69,9 @@ class SnesIntegrator final : public MembraneIntegrator {
   double last_ratio_ = 0;
   // -ksp_atol given in petsc_options: it replaces the stop at 0.9 of the Newton tolerance.
   PetscBool user_atol_ = PETSC_FALSE;
+  void* ksp_default_ctx_ = nullptr;  // PETSc's default KSP test, which gmres_converged extends
+  std::vector<double> gmres_history_;  // the current solve's residual norms
+  bool gmres_stalled_ = false;         // a solve of this step stalled
 };
 
 }  // namespace immerse
