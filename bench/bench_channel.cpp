@@ -4,19 +4,23 @@
 //   - JFNK at the scenario's dt to its end time: wall time, fluid solves, Newton and GMRES iterations per step
 //     (a rejected attempt's solves count in its step; the adaptive step then advances less than dt, and wall times
 //     are scaled by the time actually simulated);
-//   - explicit midpoint RK2: its largest stable dt, by bisection on log(dt) with a blow-up test (a run of
-//     `probe` steps is unstable when Simulation::advance reports it: a non-finite position or velocity, or a node
-//     faster than 4 mm/s, 11 times the empty duct's centre velocity; a slowly growing instability can pass the test,
-//     so the bisection can only overestimate the stable step, in the explicit scheme's favour), then its wall time per step over
-//     `explicit_steps` steps, scaled to the end time (the full explicit run would take hours; said in the output);
+//   - explicit midpoint RK2: its largest stable dt, the largest step at which a run reaches the end time without a
+//     blow-up (Simulation::advance reports a non-finite position or velocity, or a node faster than 4 mm/s, 11 times
+//     the empty duct's centre velocity). Every probe runs to the end time: the scheme's instability can grow for
+//     hundreds of steps before it shows. From dt/8 the probes halve the step until one reaches the end time, then
+//     bisect on log(dt) three times; each is started only if its full run fits into the budget (--rk2-budget) at the
+//     pace measured so far. The explicit wall time is the full run at the largest stable step found; if none was
+//     found within the budget, the output says so and gives bounds: the stable step lies below the smallest one
+//     tried, so the explicit run takes more than its step count times the measured time per step;
 //   - the ratio explicit / implicit of the wall times to the end time, and the peak resident memory;
 //   - for each scheme, where the time goes: membrane forces, spreading, fluid, interpolation, the rest (the
 //     nonlinear solver's vector work, stability checks), from the operator's timers (StepTimings).
-// Usage: bench_channel [--quick] [--jfnk-steps N] [--jfnk-only] [--set key=value ...]
+// Usage: bench_channel [--quick] [--jfnk-steps N] [--jfnk-only] [--rk2-budget S] [--set key=value ...]
 //   --quick         rbc_channel_quick.toml (48 x 96 x 24, 642 nodes per cell) instead of rbc_channel.toml
 //   --jfnk-steps N  time N steps of JFNK and scale to the end time (by the time they simulated) instead of running
 //                   it all
 //   --jfnk-only     skip the explicit scheme
+//   --rk2-budget S  wall-clock seconds for the explicit probes (default 3600)
 //   --set k=v       as for immerse run, e.g. --set scenario.mu0=1e-3 for stiffer cells
 #include <sys/resource.h>
 
@@ -24,6 +28,8 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <limits>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -65,33 +71,68 @@ io::Config channel_config(const std::string& file, const std::string& scheme, do
   return apply_scenario(run_schema().parse_file(file, sets));
 }
 
-// Runs `steps` steps (all to the end time when steps <= 0); the first step (no history) is timed too.
+// Advances `sim` by `steps` steps (to its end time when steps <= 0; the first step, without history, is timed too),
+// or until `budget_s` seconds of wall time have passed, adding to `c`. A blow-up propagates as SimulationError, with
+// what was run until then accounted in `c`.
+void run(Simulation& sim, long steps, double budget_s, Cost& c) {
+  const StepTimings start = sim.op().timings();
+  const auto t0 = Clock::now();
+  const auto elapsed = [&] { return std::chrono::duration<double>(Clock::now() - t0).count(); };
+  const auto account = [&] {
+    c.seconds = elapsed();
+    c.parts = sim.op().timings().since(start);
+  };
+  try {
+    while (!sim.finished() && (steps <= 0 || c.steps < steps) && elapsed() < budget_s) {
+      const StepRecord r = sim.advance([](const std::string& msg) { std::printf("  %s\n", msg.c_str()); });
+      ++c.steps;
+      c.rejected += r.rejected;
+      c.simulated += r.dt;
+      c.solves += double(r.stats.fluid_solves);
+      c.newton += double(r.stats.newton_its);
+      c.gmres += double(r.stats.gmres_its);
+    }
+  } catch (const SimulationError&) {
+    account();
+    throw;
+  }
+  account();
+}
+
 Cost run(const io::Config& config, long steps) {
   Simulation sim(config);
   Cost c;
-  const StepTimings start = sim.op().timings();
-  const auto t0 = Clock::now();
-  while (!sim.finished() && (steps <= 0 || c.steps < steps)) {
-    const StepRecord r = sim.advance([](const std::string& msg) { std::printf("  %s\n", msg.c_str()); });
-    ++c.steps;
-    c.rejected += r.rejected;
-    c.simulated += r.dt;
-    c.solves += double(r.stats.fluid_solves);
-    c.newton += double(r.stats.newton_its);
-    c.gmres += double(r.stats.gmres_its);
-  }
-  c.seconds = std::chrono::duration<double>(Clock::now() - t0).count();
-  c.parts = sim.op().timings().since(start);
+  run(sim, steps, std::numeric_limits<double>::infinity(), c);
   return c;
 }
 
-bool rk2_stable(const std::string& file, double dt, long probe) {
+// An explicit RK2 run at dt towards the end time: stable when it gets there, unstable when Simulation::advance
+// reports a blow-up first (a non-finite value or a node faster than 4 mm/s), undecided when `budget_s` seconds of
+// wall time end first.
+struct Probe {
+  enum Outcome { stable, unstable, undecided } outcome = undecided;
+  double dt = 0, reached = 0;  // the step and the time the run reached
+  std::string why;             // the blow-up, as Simulation::advance reported it
+  Cost cost;
+};
+
+Probe rk2_probe(const std::string& file, double dt, double budget_s) {
+  Simulation sim(channel_config(file, "rk2", dt, 4e-3));
+  Probe p;
+  p.dt = dt;
   try {
-    run(channel_config(file, "rk2", dt, 4e-3), probe);
-  } catch (const SimulationError&) {
-    return false;
+    run(sim, 0, budget_s, p.cost);
+    p.outcome = sim.finished() ? Probe::stable : Probe::undecided;
+  } catch (const SimulationError& e) {
+    p.outcome = Probe::unstable;
+    p.why = e.what();
   }
-  return true;
+  p.reached = sim.time();
+  const char* what[] = {"reached t_end", "blew up", "undecided (budget spent)"};
+  std::printf("  RK2 dt = %.4g s: %s at t = %.4g s after %ld steps, %.1f s (%.3f s/step)%s%s\n", dt, what[p.outcome],
+              p.reached, p.cost.steps, p.cost.seconds, p.cost.per_step(), p.why.empty() ? "" : ": ", p.why.c_str());
+  std::fflush(stdout);
+  return p;
 }
 
 double peak_rss_mib() {
@@ -103,18 +144,20 @@ double peak_rss_mib() {
 }  // namespace
 
 // The whole benchmark for one scenario file (throws InputError on a bad --set).
-int measure(const std::string& file, long jfnk_steps, bool quick, bool jfnk_only);
+int measure(const std::string& file, long jfnk_steps, bool jfnk_only, double rk2_budget);
 
 int main(int argc, char** argv) {
   bool quick = false, jfnk_only = false;
   long jfnk_steps = 0;
+  double rk2_budget = 3600;
   for (int i = 1; i < argc; ++i) {
     if (std::strcmp(argv[i], "--quick") == 0) quick = true;
     else if (std::strcmp(argv[i], "--jfnk-only") == 0) jfnk_only = true;
     else if (std::strcmp(argv[i], "--jfnk-steps") == 0 && i + 1 < argc) jfnk_steps = std::stol(argv[++i]);
+    else if (std::strcmp(argv[i], "--rk2-budget") == 0 && i + 1 < argc) rk2_budget = std::stod(argv[++i]);
     else if (std::strcmp(argv[i], "--set") == 0 && i + 1 < argc) g_sets.emplace_back(argv[++i]);
     else {
-      std::fprintf(stderr, "usage: bench_channel [--quick] [--jfnk-steps N] [--jfnk-only] [--set key=value ...]\n");
+      std::fprintf(stderr, "usage: bench_channel [--quick] [--jfnk-steps N] [--jfnk-only] [--rk2-budget S] [--set key=value ...]\n");
       return 2;
     }
   }
@@ -122,7 +165,7 @@ int main(int argc, char** argv) {
       std::string(IMMERSE_SOURCE_DIR) + (quick ? "/scenarios/rbc_channel_quick.toml" : "/scenarios/rbc_channel.toml");
   PetscSession petsc;
   try {
-    return measure(file, jfnk_steps, quick, jfnk_only);
+    return measure(file, jfnk_steps, jfnk_only, rk2_budget);
   } catch (const InputError& e) {
     std::fprintf(stderr, "bench_channel: %s\n", e.what());
     return 2;
@@ -132,7 +175,7 @@ int main(int argc, char** argv) {
   }
 }
 
-int measure(const std::string& file, long jfnk_steps, bool quick, bool jfnk_only) {
+int measure(const std::string& file, long jfnk_steps, bool jfnk_only, double rk2_budget) {
   const io::Config base = channel_config(file, "jfnk", 0);
   const double dt = base.get<double>("time.dt"), T = base.get<double>("time.end");
   std::printf("§4.4 rbc_channel (%s): %lld x %lld x %lld grid, 32 cells of %s level %lld, mu0 = %g N/m, dt = %g s, "
@@ -156,27 +199,56 @@ int measure(const std::string& file, long jfnk_steps, bool quick, bool jfnk_only
     return 0;
   }
 
-  // Largest stable RK2 step: bracket [lo stable, hi unstable], then bisect on log(dt).
-  const long probe = quick ? 100 : 60;
-  double lo = dt / 256, hi = dt / 8;
-  while (rk2_stable(file, hi, probe) && hi < dt) lo = hi, hi *= 4;
-  while (!rk2_stable(file, lo, probe)) hi = lo, lo /= 4;
-  for (int it = 0; it < 5; ++it) {
-    const double mid = std::sqrt(lo * hi);
-    (rk2_stable(file, mid, probe) ? lo : hi) = mid;
-    std::printf("  RK2 bracket [%.4g, %.4g] s\n", lo, hi);
-    std::fflush(stdout);
+  // Largest step at which explicit RK2 reaches t_end. Its instability can grow slowly (at the paper's size a node
+  // runs away after 64 steps at dt = 8.3e-5 s, after 654 at 1.5e-5 s), so every probe runs to t_end: from dt/8,
+  // halved until a probe gets there (doubled while it does, if the first does), then bisected on log(dt). A probe is
+  // started only if its full run fits into what is left of the budget at the pace measured so far.
+  const auto start = Clock::now();
+  const auto left = [&] { return rk2_budget - std::chrono::duration<double>(Clock::now() - start).count(); };
+  double spent = 0, stepped = 0;  // RK2's wall time and steps so far
+  const auto fits = [&](double d) { return stepped == 0 || T / d * (spent / stepped) <= left(); };
+  std::optional<Probe> lo, hi;  // the largest step found stable, the smallest found unstable
+  const auto probe = [&](double d) {
+    if (!fits(d)) return false;
+    Probe p = rk2_probe(file, d, left());
+    spent += p.cost.seconds;
+    stepped += double(p.cost.steps);
+    if (p.outcome == Probe::undecided) return false;
+    (p.outcome == Probe::stable ? lo : hi) = p;
+    return true;
+  };
+  for (double d = dt / 8; !lo; d /= 2)  // down until a probe reaches t_end
+    if (!probe(d)) break;
+  if (lo)  // up while probes reach it (when the first did)
+    for (double d = 2 * lo->dt; !hi && d < dt; d *= 2)
+      if (!probe(d)) break;
+  for (int it = 0; it < 3 && lo && hi; ++it)
+    if (!probe(std::sqrt(lo->dt * hi->dt))) break;
+
+  const char* jfnk_scaled = jfnk_steps > 0 ? " (scaled)" : "";
+  if (lo) {
+    std::printf("RK2: largest stable dt = %.4g s (paper: 1.875e-6): reaches t_end in %ld steps, %.3f s/step, %.2f fluid "
+                "solves/step; %s %.4g s blows up\n",
+                lo->dt, lo->cost.steps, lo->cost.per_step(), lo->cost.solves / double(lo->cost.steps),
+                hi ? "" : "no larger step tried below the scenario's dt; at", hi ? hi->dt : dt);
+    lo->cost.print_profile("RK2");
+    std::printf("wall time to t = %g s: JFNK %.1f s%s, explicit RK2 %.1f s (measured: a full run at its largest "
+                "stable step)\n",
+                T, t_jfnk, jfnk_scaled, lo->cost.seconds);
+    std::printf("ratio explicit / implicit: %.1f (paper: 43)\n", lo->cost.seconds / t_jfnk);
+  } else if (hi) {
+    const double steps = T / hi->dt, t_bound = steps * hi->cost.per_step();
+    std::printf("RK2: no step reached t_end within the %.0f s budget (--rk2-budget); every step tried down to %.4g s "
+                "blows up (there at t = %.4g s): the largest stable dt is below it (paper: 1.875e-6)\n",
+                rk2_budget, hi->dt, hi->reached);
+    hi->cost.print_profile("RK2");
+    std::printf("wall time to t = %g s: JFNK %.1f s%s, explicit RK2 more than %.1f s (more than %.0f steps at %.3f "
+                "s/step)\n",
+                T, t_jfnk, jfnk_scaled, t_bound, steps, hi->cost.per_step());
+    std::printf("ratio explicit / implicit: at least %.1f (paper: 43)\n", t_bound / t_jfnk);
+  } else {
+    std::printf("RK2: no probe decided within the %.0f s budget (--rk2-budget)\n", rk2_budget);
   }
-  const long explicit_steps = quick ? 40 : 20;
-  const Cost e = run(channel_config(file, "rk2", lo), explicit_steps);
-  const double t_explicit = e.scaled_to(T);
-  std::printf("RK2: largest stable dt = %.4g s (paper: 1.875e-6; %ld-step blow-up test), %.3f s/step, %.2f fluid "
-              "solves/step; %.0f steps to t_end\n",
-              lo, probe, e.per_step(), e.solves / double(e.steps), T / lo);
-  e.print_profile("RK2");
-  std::printf("wall time to t = %g s: JFNK %.1f s%s, explicit RK2 %.1f s (from %ld timed steps, scaled)\n", T, t_jfnk,
-              jfnk_steps > 0 ? " (scaled)" : "", t_explicit, explicit_steps);
-  std::printf("ratio explicit / implicit: %.1f (paper: 43)\n", t_explicit / t_jfnk);
   std::printf("peak resident memory: %.0f MiB\n", peak_rss_mib());
   return 0;
 }
