@@ -25,10 +25,11 @@
 //   --set k=v       as for immerse run, e.g. --set scenario.mu0=1e-3 for stiffer cells
 #include <sys/resource.h>
 
+#include <CLI/CLI.hpp>
+
 #include <chrono>
 #include <cmath>
 #include <cstdio>
-#include <cstring>
 #include <limits>
 #include <optional>
 #include <string>
@@ -152,18 +153,22 @@ int main(int argc, char** argv) {
   bool quick = false, jfnk_only = false;
   long jfnk_steps = 0;
   double rk2_budget = 3600, rk2_from = 0;
-  for (int i = 1; i < argc; ++i) {
-    if (std::strcmp(argv[i], "--quick") == 0) quick = true;
-    else if (std::strcmp(argv[i], "--jfnk-only") == 0) jfnk_only = true;
-    else if (std::strcmp(argv[i], "--jfnk-steps") == 0 && i + 1 < argc) jfnk_steps = std::stol(argv[++i]);
-    else if (std::strcmp(argv[i], "--rk2-budget") == 0 && i + 1 < argc) rk2_budget = std::stod(argv[++i]);
-    else if (std::strcmp(argv[i], "--rk2-from") == 0 && i + 1 < argc) rk2_from = std::stod(argv[++i]);
-    else if (std::strcmp(argv[i], "--set") == 0 && i + 1 < argc) g_sets.emplace_back(argv[++i]);
-    else {
-      std::fprintf(stderr, "usage: bench_channel [--quick] [--jfnk-steps N] [--jfnk-only] [--rk2-budget S] "
-                           "[--rk2-from DT] [--set key=value ...]\n");
-      return 2;
-    }
+  CLI::App app{"§4.4 whole-run benchmark: JFNK against explicit RK2 (bench/bench_channel.cpp)"};
+  app.add_flag("--quick", quick, "rbc_channel_quick.toml (48 x 96 x 24, 642-node cells) instead of rbc_channel.toml");
+  app.add_option("--jfnk-steps", jfnk_steps, "time N JFNK steps and scale to the end time (0: the whole run)");
+  app.add_flag("--jfnk-only", jfnk_only, "skip the explicit scheme");
+  app.add_option("--rk2-budget", rk2_budget, "wall-clock seconds for the explicit probes (> 0)")->capture_default_str();
+  app.add_option("--rk2-from", rk2_from, "the first explicit probe's step (s, > 0; default dt/8)");
+  app.add_option("--set", g_sets, "key=value, as for immerse run (repeatable)");
+  try {
+    app.parse(argc, argv);
+    if (jfnk_steps < 0) throw CLI::ValidationError("--jfnk-steps", "must be >= 0");
+    if (!(rk2_budget > 0)) throw CLI::ValidationError("--rk2-budget", "must be > 0");
+    if (app.count("--rk2-from") && !(rk2_from > 0)) throw CLI::ValidationError("--rk2-from", "must be > 0");
+  } catch (const CLI::ParseError& e) {
+    if (e.get_exit_code() == 0) return app.exit(e);  // --help
+    std::fprintf(stderr, "bench_channel: error: %s (see bench_channel --help)\n", e.what());
+    return 2;
   }
   const std::string file =
       std::string(IMMERSE_SOURCE_DIR) + (quick ? "/scenarios/rbc_channel_quick.toml" : "/scenarios/rbc_channel.toml");
