@@ -66,7 +66,8 @@ def main(argv):
                 f"node distance max "
                 f"{d.max():.4g} m ({d.max() / h:.4g} h), rms {rms:.4g} m ({rms / h:.4g} h); centroid max "
                 f"{centroid:.4g} m ({centroid / h:.4g} h)")
-        if previous and previous["rms"] > 0 and rms > 0 and run["dt"] != previous["dt"]:
+        halved_or_doubled = previous and any(math.isclose(run["dt"], f * previous["dt"], rel_tol=1e-9) for f in (0.5, 2))
+        if halved_or_doubled and previous["rms"] > 0 and rms > 0:
             line += f"; order {math.log(rms / previous['rms']) / math.log(run['dt'] / previous['dt']):.2f}"
         print(line)
         previous = {"rms": rms, "dt": run["dt"]}

@@ -1,8 +1,8 @@
 // scripts/compare_runs.py on real runs: the time-step error of a small oscillating-membrane run (§4.1) converges
 // at second order in the node positions (the order Table 1 shows at the paper's size), a run compared with itself
 // is at distance zero, and runs that cannot be compared are refused with a one-line error.
+#include <algorithm>
 #include <cstdlib>
-#include <regex>
 
 #include "test_run_support.hpp"
 
@@ -16,10 +16,14 @@ struct ScriptResult {
 
 /// `/usr/bin/python3 scripts/compare_runs.py DIRS...` with its output captured.
 ScriptResult compare_runs(const std::vector<fs::path>& dirs, const ScratchDir& scratch) {
-  std::string cmd = "/usr/bin/python3 " + (fs::path(IMMERSE_SOURCE_DIR) / "scripts" / "compare_runs.py").string();
-  for (const auto& d : dirs) cmd += " " + d.string();
   const fs::path out = scratch / "compare.stdout", err = scratch / "compare.stderr";
-  cmd += " >" + out.string() + " 2>" + err.string();
+  std::vector<std::string> words{"/usr/bin/python3",
+                                 (fs::path(IMMERSE_SOURCE_DIR) / "scripts" / "compare_runs.py").string()};
+  for (const auto& d : dirs) words.push_back(d.string());
+  words.push_back(">" + out.string());
+  words.push_back("2>" + err.string());
+  std::string cmd;
+  for (const auto& w : words) cmd.append(cmd.empty() ? "" : " ").append(w);
   const int rc = std::system(cmd.c_str());
   return {WIFEXITED(rc) ? WEXITSTATUS(rc) : -1, read_text(out), read_text(err)};
 }
@@ -37,11 +41,12 @@ fs::path run_to_one(const ScratchDir& scratch, const std::string& name, double d
   return dir;
 }
 
+/// The numbers that follow "LABEL " in text, in order.
 std::vector<double> numbers_after(const std::string& text, const std::string& label) {
   std::vector<double> v;
-  const std::regex re(label + " ([0-9.eE+-]+)");
-  for (auto it = std::sregex_iterator(text.begin(), text.end(), re); it != std::sregex_iterator(); ++it)
-    v.push_back(std::stod((*it)[1].str()));
+  const std::string key = label + " ";
+  for (auto at = text.find(key); at != std::string::npos; at = text.find(key, at + 1))
+    v.push_back(std::stod(text.substr(at + key.size())));
   return v;
 }
 
