@@ -5,10 +5,10 @@ Usage: /usr/bin/python3 scripts/compare_runs.py REFERENCE_DIR RUN_DIR [RUN_DIR .
 
 Each DIR is the --out directory of an `immerse run`; its checkpoint.h5 (written at the end of every run) holds the
 membrane positions. Every run must have the same membranes (node counts) and end at the same time as the reference.
-For each run, one line: its time step, steps, fluid solves (from diagnostics.csv, when it has a row per step), and the distance of its nodes
-from the reference's: the largest and the root-mean-square over all nodes of all membranes, in metres and in grid
-spacings h (the smallest of domain.L / grid.n), and the largest distance between a membrane's centroid (mean of its
-nodes) and the reference's. With two or more runs whose steps halve or double, the observed order of the
+For each run, one line: its time step, steps, fluid solves (from diagnostics.csv, when it has a row per step), and
+the distance of its nodes from the reference's: the largest and the root-mean-square over all nodes of all
+membranes, in metres and in grid spacings h (the smallest of domain.L / grid.n), and the largest distance between a
+membrane's centroid (mean of its nodes) and the reference's. With two or more runs whose steps halve or double, the observed order of the
 root-mean-square error between consecutive runs, log(e2/e1)/log(dt2/dt1).
 """
 import math
@@ -63,10 +63,10 @@ def main(argv):
         solves = "" if run["solves"] is None else \
             f", {run['solves']} fluid solves ({run['solves'] / run['steps']:.2f} per step)"
         line = (f"{run_dir}: {run['config']['time']['scheme']}, dt = {run['dt']:.6g} s, {run['steps']} steps{solves}; "
-                f"node distance max "
-                f"{d.max():.4g} m ({d.max() / h:.4g} h), rms {rms:.4g} m ({rms / h:.4g} h); centroid max "
-                f"{centroid:.4g} m ({centroid / h:.4g} h)")
-        halved_or_doubled = previous and any(math.isclose(run["dt"], f * previous["dt"], rel_tol=1e-9) for f in (0.5, 2))
+                f"node distance max {d.max():.4g} m ({d.max() / h:.4g} h), rms {rms:.4g} m ({rms / h:.4g} h); "
+                f"centroid max {centroid:.4g} m ({centroid / h:.4g} h)")
+        halved_or_doubled = previous and any(math.isclose(run["dt"], f * previous["dt"], rel_tol=1e-9)
+                                             for f in (0.5, 2))
         if halved_or_doubled and previous["rms"] > 0 and rms > 0:
             line += f"; order {math.log(rms / previous['rms']) / math.log(run['dt'] / previous['dt']):.2f}"
         print(line)
