@@ -8,8 +8,8 @@ membrane positions. Every run must have the same membranes (node counts) and end
 For each run, one line: its time step, steps, fluid solves (from diagnostics.csv, when it has a row per step), and
 the distance of its nodes from the reference's: the largest and the root-mean-square over all nodes of all
 membranes, in metres and in grid spacings h (the smallest of domain.L / grid.n), and the largest distance between a
-membrane's centroid (mean of its nodes) and the reference's. With two or more runs whose steps halve or double, the observed order of the
-root-mean-square error between consecutive runs, log(e2/e1)/log(dt2/dt1).
+membrane's centroid (mean of its nodes) and the reference's. Between consecutive runs whose steps halve or double,
+the observed order of the root-mean-square error, log(e2/e1)/log(dt2/dt1).
 """
 import math
 import os
