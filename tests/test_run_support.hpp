@@ -134,11 +134,11 @@ inline RunResult run_immerse(const std::vector<std::string>& args, const fs::pat
   return {status, p.out(), p.err()};
 }
 
-/// `--set` arguments turning oscillating_membrane_quick.toml into a small run of `steps` steps of dt = 0.125
-/// (16^3 grid, unit box, octahedral level-1 membrane of 66 nodes).
-inline std::vector<std::string> small_membrane_sets(int steps) {
-  return {"grid.nx=16", "grid.ny=16", "grid.nz=16", "membrane[0].mesh.level=1", "time.dt=0.125",
-          "time.end=" + std::to_string(0.125 * steps), "output.fields_every=0", "output.checkpoint_every=0"};
+/// `--set` arguments turning oscillating_membrane_quick.toml into a small run of `steps` steps of dt (default 0.125;
+/// 16^3 grid, unit box, octahedral level-1 membrane of 66 nodes).
+inline std::vector<std::string> small_membrane_sets(int steps, double dt = 0.125) {
+  return {"grid.nx=16", "grid.ny=16", "grid.nz=16", "membrane[0].mesh.level=1", "time.dt=" + std::to_string(dt),
+          "time.end=" + std::to_string(dt * steps), "output.fields_every=0", "output.checkpoint_every=0"};
 }
 
 /// The command line `run FILE --out DIR --set ...`.
