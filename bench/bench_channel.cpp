@@ -1,9 +1,9 @@
 // §4.4 whole-run benchmark: 32 red blood cells in the 24 x 48 x 12 um duct (scenarios/rbc_channel.toml: 64x128x32
 // grid, 10,242 nodes per cell), the paper's performance claim (JFNK at dt = 4.5e-4 s to t = 0.05 s in 22 min, 43
 // times faster than explicit RK2, whose largest stable step was 1.875e-6 s). Measures, in this one run:
-//   - JFNK at the scenario's dt to its end time: wall time, fluid solves, Newton and GMRES iterations per step
-//     (a rejected attempt's solves count in its step; the adaptive step then advances less than dt, and wall times
-//     are scaled by the time actually simulated);
+//   - the implicit scheme (JFNK, or each scheme --implicit lists) at the scenario's dt to its end time: wall time,
+//     fluid solves, Newton (Anderson) and GMRES iterations per step (a rejected attempt's solves count in its step;
+//     the adaptive step then advances less than dt, and wall times are scaled by the time actually simulated);
 //   - explicit midpoint RK2: its largest stable dt, the largest step at which a run reaches the end time without a
 //     blow-up (Simulation::advance reports a non-finite position or velocity, or a node faster than 4 mm/s, 11 times
 //     the empty duct's centre velocity). Every probe runs to the end time: the scheme's instability can grow for
@@ -12,13 +12,17 @@
 //     (--rk2-budget) at the pace measured so far. The explicit wall time is the full run at the largest stable step
 //     found; if none was found within the budget, the output says so and gives bounds: the stable step lies below
 //     the smallest one tried, so the explicit run takes more than its step count times the measured time per step;
-//   - the ratio explicit / implicit of the wall times to the end time, and the peak resident memory;
+//   - the ratio explicit / implicit of the wall times to the end time (for each implicit scheme), and the peak
+//     resident memory;
 //   - for each scheme, where the time goes: membrane forces, spreading, fluid, interpolation, the rest (the
 //     nonlinear solver's vector work, stability checks), from the operator's timers (StepTimings).
-// Usage: bench_channel [--quick] [--jfnk-steps N] [--jfnk-only] [--rk2-budget S] [--rk2-from DT] [--set key=value ...]
+// Usage: bench_channel [--quick] [--implicit S,...] [--jfnk-steps N] [--jfnk-only] [--rk2-budget S] [--rk2-from DT]
+//                      [--set key=value ...]
 //   --quick         rbc_channel_quick.toml (48 x 96 x 24, 642 nodes per cell) instead of rbc_channel.toml
-//   --jfnk-steps N  time N steps of JFNK and scale to the end time (by the time they simulated) instead of running
-//                   it all
+//   --implicit S,.. the implicit schemes to time, each against the same explicit run: jfnk (default, the paper's),
+//                   anderson, lbfgs
+//   --jfnk-steps N  time N steps of each implicit scheme and scale to the end time (by the time they simulated)
+//                   instead of running it all
 //   --jfnk-only     skip the explicit scheme
 //   --rk2-budget S  wall-clock seconds for the explicit probes (default 3600)
 //   --rk2-from DT   the first explicit probe's step (default dt/8)
@@ -147,15 +151,22 @@ double peak_rss_mib() {
 }  // namespace
 
 // The whole benchmark for one scenario file (throws InputError on a bad --set).
-int measure(const std::string& file, long jfnk_steps, bool jfnk_only, double rk2_budget, double rk2_from);
+int measure(const std::string& file, const std::vector<std::string>& implicit, long jfnk_steps, bool jfnk_only,
+            double rk2_budget, double rk2_from);
 
 int main(int argc, char** argv) {
   bool quick = false, jfnk_only = false;
   long jfnk_steps = 0;
   double rk2_budget = 3600, rk2_from = 0;
+  std::vector<std::string> implicit{"jfnk"};
   CLI::App app{"§4.4 whole-run benchmark: JFNK against explicit RK2 (bench/bench_channel.cpp)"};
   app.add_flag("--quick", quick, "rbc_channel_quick.toml (48 x 96 x 24, 642-node cells) instead of rbc_channel.toml");
-  app.add_option("--jfnk-steps", jfnk_steps, "time N JFNK steps and scale to the end time (0: the whole run)");
+  app.add_option("--implicit", implicit, "implicit schemes to time against the explicit run, comma-separated")
+      ->delimiter(',')
+      ->check(CLI::IsMember({"jfnk", "anderson", "lbfgs"}))
+      ->capture_default_str();
+  app.add_option("--jfnk-steps", jfnk_steps,
+                 "time N steps of each implicit scheme and scale to the end time (0: the whole run)");
   app.add_flag("--jfnk-only", jfnk_only, "skip the explicit scheme");
   app.add_option("--rk2-budget", rk2_budget, "wall-clock seconds for the explicit probes (> 0)")->capture_default_str();
   app.add_option("--rk2-from", rk2_from, "the first explicit probe's step (s, > 0; default dt/8)");
@@ -174,18 +185,19 @@ int main(int argc, char** argv) {
       std::string(IMMERSE_SOURCE_DIR) + (quick ? "/scenarios/rbc_channel_quick.toml" : "/scenarios/rbc_channel.toml");
   PetscSession petsc;
   try {
-    return measure(file, jfnk_steps, jfnk_only, rk2_budget, rk2_from);
+    return measure(file, implicit, jfnk_steps, jfnk_only, rk2_budget, rk2_from);
   } catch (const InputError& e) {
     std::fprintf(stderr, "bench_channel: %s\n", e.what());
     return 2;
   } catch (const SimulationError& e) {
-    std::fprintf(stderr, "bench_channel: the JFNK run stopped: %s\n", e.what());
+    std::fprintf(stderr, "bench_channel: the implicit run stopped: %s\n", e.what());
     return 3;
   }
 }
 
-int measure(const std::string& file, long jfnk_steps, bool jfnk_only, double rk2_budget, double rk2_from) {
-  const io::Config base = channel_config(file, "jfnk", 0);
+int measure(const std::string& file, const std::vector<std::string>& implicit, long jfnk_steps, bool jfnk_only,
+            double rk2_budget, double rk2_from) {
+  const io::Config base = channel_config(file, implicit.front(), 0);
   const double dt = base.get<double>("time.dt"), T = base.get<double>("time.end");
   std::printf("§4.4 rbc_channel (%s): %lld x %lld x %lld grid, 32 cells of %s level %lld, mu0 = %g N/m, dt = %g s, "
               "t_end = %g s\n",
@@ -193,16 +205,25 @@ int measure(const std::string& file, long jfnk_steps, bool jfnk_only, double rk2
               (long long)base.get<int>("grid.nz"), base.get<std::string>("membrane[0].mesh.family").c_str(),
               (long long)base.get<int>("membrane[0].mesh.level"), base.get<double>("scenario.mu0"), dt, T);
 
-  const Cost j = run(base, jfnk_steps);
-  const double t_jfnk = j.scaled_to(T);
-  std::printf("JFNK: %ld steps in %.1f s (%.3f s/step), per step %.2f fluid solves, %.2f Newton, %.2f GMRES%s\n",
-              j.steps, j.seconds, j.per_step(), j.solves / double(j.steps), j.newton / double(j.steps),
-              j.gmres / double(j.steps), jfnk_steps > 0 ? " (scaled to t_end below)" : "");
-  if (j.rejected > 0)
-    std::printf("JFNK: %ld attempts rejected (their fluid solves counted above); mean accepted dt %.4g s\n",
-                j.rejected, j.simulated / double(j.steps));
-  j.print_profile("JFNK");
-  std::fflush(stdout);
+  struct Timed {
+    std::string label;
+    double to_end;  // wall time to t_end
+  };
+  std::vector<Timed> timed;
+  for (const std::string& scheme : implicit) {
+    const std::string label = scheme == "jfnk" ? "JFNK" : scheme == "anderson" ? "Anderson" : "L-BFGS";
+    const Cost j = run(channel_config(file, scheme, 0), jfnk_steps);
+    timed.push_back({label, j.scaled_to(T)});
+    std::printf("%s: %ld steps in %.1f s (%.3f s/step), per step %.2f fluid solves, %.2f %s, %.2f GMRES%s\n",
+                label.c_str(), j.steps, j.seconds, j.per_step(), j.solves / double(j.steps),
+                j.newton / double(j.steps), scheme == "jfnk" ? "Newton" : "nonlinear iterations",
+                j.gmres / double(j.steps), jfnk_steps > 0 ? " (scaled to t_end below)" : "");
+    if (j.rejected > 0)
+      std::printf("%s: %ld attempts rejected (their fluid solves counted above); mean accepted dt %.4g s\n",
+                  label.c_str(), j.rejected, j.simulated / double(j.steps));
+    j.print_profile(label.c_str());
+    std::fflush(stdout);
+  }
   if (jfnk_only) {
     std::printf("peak resident memory: %.0f MiB\n", peak_rss_mib());
     return 0;
@@ -234,7 +255,7 @@ int measure(const std::string& file, long jfnk_steps, bool jfnk_only, double rk2
   for (int it = 0; it < 3 && lo && hi; ++it)
     if (!probe(std::sqrt(lo->dt * hi->dt))) break;
 
-  const char* jfnk_scaled = jfnk_steps > 0 ? " (scaled)" : "";
+  const char* scaled = jfnk_steps > 0 ? " (scaled)" : "";
   if (lo) {
     char above[96] = "no larger step was found to blow up: the largest stable step may be larger";
     if (hi) std::snprintf(above, sizeof above, "%.4g s blows up (at t = %.4g s)", hi->dt, hi->reached);
@@ -242,27 +263,31 @@ int measure(const std::string& file, long jfnk_steps, bool jfnk_only, double rk2
                 "fluid solves/step; %s\n",
                 lo->dt, lo->cost.steps, lo->cost.per_step(), lo->cost.solves / double(lo->cost.steps), above);
     lo->cost.print_profile("RK2");
-    std::printf("wall time to t = %g s: JFNK %.1f s%s, explicit RK2 %.1f s (measured: a full run at its largest "
-                "stable step)\n",
-                T, t_jfnk, jfnk_scaled, lo->cost.seconds);
-    // The largest stable step lies in [lo, hi): RK2's time to t_end between (T/hi) steps and the measured run.
-    const double ratio = lo->cost.seconds / t_jfnk;
-    if (hi)
-      std::printf("ratio explicit / implicit: %.1f (paper: 43; with the largest stable step anywhere below %.4g s: "
-                  "between %.1f and %.1f)\n",
-                  ratio, hi->dt, T / hi->dt * lo->cost.per_step() / t_jfnk, ratio);
-    else
-      std::printf("ratio explicit / implicit: at most %.1f (paper: 43)\n", ratio);
+    for (const Timed& t : timed) {
+      std::printf("wall time to t = %g s: %s %.1f s%s, explicit RK2 %.1f s (measured: a full run at its largest "
+                  "stable step)\n",
+                  T, t.label.c_str(), t.to_end, scaled, lo->cost.seconds);
+      // The largest stable step lies in [lo, hi): RK2's time to t_end between (T/hi) steps and the measured run.
+      const double ratio = lo->cost.seconds / t.to_end;
+      if (hi)
+        std::printf("ratio explicit / implicit (%s): %.1f (paper: 43; with the largest stable step anywhere below "
+                    "%.4g s: between %.1f and %.1f)\n",
+                    t.label.c_str(), ratio, hi->dt, T / hi->dt * lo->cost.per_step() / t.to_end, ratio);
+      else
+        std::printf("ratio explicit / implicit (%s): at most %.1f (paper: 43)\n", t.label.c_str(), ratio);
+    }
   } else if (hi) {
     const double steps = T / hi->dt, t_bound = steps * hi->cost.per_step();
     std::printf("RK2: no step reached t_end within the %.0f s budget (--rk2-budget); every step tried down to %.4g s "
                 "blows up (there at t = %.4g s): the largest stable dt is below it (paper: 1.875e-6)\n",
                 rk2_budget, hi->dt, hi->reached);
     hi->cost.print_profile("RK2");
-    std::printf("wall time to t = %g s: JFNK %.1f s%s, explicit RK2 more than %.1f s (more than %.0f steps at %.3f "
-                "s/step)\n",
-                T, t_jfnk, jfnk_scaled, t_bound, steps, hi->cost.per_step());
-    std::printf("ratio explicit / implicit: at least %.1f (paper: 43)\n", t_bound / t_jfnk);
+    for (const Timed& t : timed) {
+      std::printf("wall time to t = %g s: %s %.1f s%s, explicit RK2 more than %.1f s (more than %.0f steps at %.3f "
+                  "s/step)\n",
+                  T, t.label.c_str(), t.to_end, scaled, t_bound, steps, hi->cost.per_step());
+      std::printf("ratio explicit / implicit (%s): at least %.1f (paper: 43)\n", t.label.c_str(), t_bound / t.to_end);
+    }
   } else {
     std::printf("RK2: no probe decided within the %.0f s budget (--rk2-budget)\n", rk2_budget);
   }

@@ -69,7 +69,7 @@ TEST_P(RestartTest, HalfRunPlusRestartEqualsOneRunBitwise) {
   EXPECT_EQ(read_text(dir / "whole" / "fluid.xdmf"), read_text(dir / "split" / "fluid.xdmf"));
 }
 
-INSTANTIATE_TEST_SUITE_P(Run, RestartTest, ::testing::Values("jfnk", "lbfgs", "bfgs", "euler", "rk2"),
+INSTANTIATE_TEST_SUITE_P(Run, RestartTest, ::testing::Values("jfnk", "lbfgs", "bfgs", "euler", "rk2", "anderson"),
                          [](const auto& p) { return p.param; });
 
 }  // namespace

@@ -63,6 +63,14 @@ TEST(Integrators, QuasiNewtonVariantsAreSecondOrder) {
   }
 }
 
+TEST(Integrators, AndersonAccelerationIsSecondOrder) {
+  // The same trapezoidal update (31), solved by Anderson acceleration instead of Newton: the same orders.
+  const double px = order("anderson", false), pv = order("anderson", true);
+  std::cout << "anderson observed orders: X " << px << ", u " << pv << "\n";
+  EXPECT_GE(px, 1.9);
+  EXPECT_GE(pv, 1.9);
+}
+
 TEST(Integrators, MidpointRK2IsSecondOrderAndEulerFirst) {
   const double p2 = order("rk2", false), p1 = order("euler", false);
   std::cout << "rk2 order " << p2 << ", euler order " << p1 << "\n";
@@ -106,16 +114,19 @@ TEST(Integrators, BackwardEulerRemovesTheRingingOfStiffModes) {
 TEST(Integrators, QuasiNewtonAndJfnkReachTheSameStep) {
   SolverSettings s;
   s.newton_rtol = 1e-12;
-  auto a = make_toy(), b = make_toy(), c = make_toy();
+  auto a = make_toy(), b = make_toy(), c = make_toy(), d = make_toy();
   auto jfnk = make_integrator("jfnk", s), bfgs = make_integrator("bfgs", s), lbfgs = make_integrator("lbfgs", s);
+  auto anderson = make_integrator("anderson", s);
   for (int i = 0; i < 3; ++i) {
     EXPECT_TRUE(jfnk->step(a, 0.05).converged);
     EXPECT_TRUE(bfgs->step(b, 0.05).converged);
     EXPECT_TRUE(lbfgs->step(c, 0.05).converged);
+    EXPECT_TRUE(anderson->step(d, 0.05).converged);
   }
   for (std::size_t i = 0; i < a.size(); ++i) {
     EXPECT_NEAR(a.positions()[i], b.positions()[i], 1e-10);
     EXPECT_NEAR(a.positions()[i], c.positions()[i], 1e-10);
+    EXPECT_NEAR(a.positions()[i], d.positions()[i], 1e-10);
   }
 }
 
@@ -151,6 +162,17 @@ TEST(Integrators, BadNamesAndSettingsAreRejected) {
   SolverSettings s;
   s.gmres_rtol = 0;
   EXPECT_THROW(make_integrator("jfnk", s), InputError);
+  SolverSettings a;
+  a.anderson_beta = 0;
+  try {
+    make_integrator("anderson", a);
+    FAIL() << "anderson_beta = 0 accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("solver.anderson_beta"), std::string::npos) << e.what();
+  }
+  a.anderson_beta = 0.85;
+  a.anderson_memory = 0;
+  EXPECT_THROW(make_integrator("anderson", a), InputError);
   SolverSettings p;
   p.petsc_options = "-snes_no_such_option 3";
   auto op = make_toy();

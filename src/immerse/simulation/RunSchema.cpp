@@ -101,7 +101,9 @@ ConfigSchema run_schema() {
                "discrete delta: Roma-Peskin-Berger 3-point of eq. (8), or Peskin's 4-point");
 
   s.add_string("time.scheme", "jfnk", integrator_names(),
-               "membrane update: jfnk (§2.4.3), lbfgs, bfgs (eq. 35, small meshes), euler (eq. 28), rk2");
+               "membrane update: jfnk (§2.4.3), lbfgs, bfgs (eq. 35, small meshes), euler (eq. 28), rk2, anderson "
+               "(Anderson acceleration of the implicit update: fewer fluid solves than jfnk on soft cells, §4.4; "
+               "jfnk on stiff ones)");
   s.add_double("time.dt", 1e-4, Range::positive(), "time step (s)");
   s.add_double("time.end", 1e-2, Range::positive(), "end time (s)");
   s.add_double("time.theta", 0.5, Range::closed(0.5, 1.0),
@@ -114,6 +116,10 @@ ConfigSchema run_schema() {
   s.add_double("solver.gmres_rtol", 1e-3, Range::open(0, 1), "relative tolerance of each GMRES solve (§4: 1e-3)");
   s.add_int("solver.max_newton_its", 20, Range::at_least(1), "nonlinear iterations before a step is rejected and halved");
   s.add_int("solver.bfgs_memory", 20, Range::at_least(1), "stored pairs of the limited-memory quasi-Newton");
+  s.add_int("solver.anderson_memory", 5, Range::at_least(1),
+            "time.scheme = anderson: the depth m, the number of past residuals mixed");
+  s.add_double("solver.anderson_beta", 0.85, Range::open_closed(0, 2),
+               "time.scheme = anderson: the mixing parameter beta of the fixed-point map X - beta g(X)");
   s.add_string("solver.initial_guess", "recurrence", {"recurrence", "extrapolation"},
                "Newton's start: the linear extrapolation of §3 step 1 plus the error a recurrence fitted to the last "
                "steps' errors predicts (recurrence), or the extrapolation alone (extrapolation, the paper's)");

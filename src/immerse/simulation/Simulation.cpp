@@ -51,6 +51,8 @@ SolverSettings make_settings(const io::Config& c) {
   s.gmres_rtol = c.get<double>("solver.gmres_rtol");
   s.max_newton_its = c.get<int>("solver.max_newton_its");
   s.bfgs_memory = c.get<int>("solver.bfgs_memory");
+  s.anderson_memory = c.get<int>("solver.anderson_memory");
+  s.anderson_beta = c.get<double>("solver.anderson_beta");
   s.petsc_options = c.get<std::string>("solver.petsc_options");
   s.initial_guess = c.get<std::string>("solver.initial_guess") == "extrapolation"
                         ? SolverSettings::InitialGuess::Extrapolation

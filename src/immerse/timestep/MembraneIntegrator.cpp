@@ -18,6 +18,9 @@ void SolverSettings::validate() const {
           "in (0, 1)");
   require(max_newton_its >= 1, "solver.max_newton_its", max_newton_its, "an integer >= 1");
   require(bfgs_memory >= 1, "solver.bfgs_memory", bfgs_memory, "an integer >= 1");
+  require(anderson_memory >= 1, "solver.anderson_memory", anderson_memory, "an integer >= 1");
+  require(std::isfinite(anderson_beta) && anderson_beta > 0 && anderson_beta <= 2, "solver.anderson_beta",
+          anderson_beta, "in (0, 2]");
 }
 
 void MembraneIntegrator::set_history(std::vector<double> previous_positions, double previous_dt,
@@ -51,7 +54,7 @@ void MembraneIntegrator::remember(const CoupledOperator& op, double dt, std::spa
 }
 
 const std::vector<std::string>& integrator_names() {
-  static const std::vector<std::string> names{"euler", "rk2", "jfnk", "bfgs", "lbfgs"};
+  static const std::vector<std::string> names{"euler", "rk2", "jfnk", "bfgs", "lbfgs", "anderson"};
   return names;
 }
 
@@ -61,8 +64,9 @@ std::unique_ptr<MembraneIntegrator> make_integrator(const std::string& name, con
   if (name == "rk2") return std::make_unique<MidpointRK2>();
   if (name == "jfnk") return std::make_unique<SnesIntegrator>(SnesIntegrator::Method::NewtonKrylov, settings);
   if (name == "lbfgs") return std::make_unique<SnesIntegrator>(SnesIntegrator::Method::LimitedMemoryBFGS, settings);
+  if (name == "anderson") return std::make_unique<SnesIntegrator>(SnesIntegrator::Method::Anderson, settings);
   if (name == "bfgs") return std::make_unique<DenseBfgs>(settings);
-  throw InputError("time.scheme = '" + name + "': must be one of euler, rk2, jfnk, bfgs, lbfgs");
+  throw InputError("time.scheme = '" + name + "': must be one of euler, rk2, jfnk, bfgs, lbfgs, anderson");
 }
 
 }  // namespace immerse

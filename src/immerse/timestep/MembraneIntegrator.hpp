@@ -21,6 +21,8 @@ struct SolverSettings {
   double gmres_rtol = 1e-3;     ///< relative tolerance of each GMRES solve
   int max_newton_its = 20;      ///< a step that needs more is rejected
   int bfgs_memory = 20;         ///< limited-memory quasi-Newton: stored pairs
+  int anderson_memory = 5;      ///< Anderson acceleration: residual differences mixed (its depth m)
+  double anderson_beta = 0.85;  ///< Anderson acceleration: the mixing (damping) parameter beta
   std::string petsc_options;    ///< extra PETSc options, e.g. "-ksp_gmres_restart 50"
   InitialGuess initial_guess = InitialGuess::Recurrence;
   void validate() const;
@@ -62,7 +64,8 @@ class MembraneIntegrator {
 };
 
 /// The schemes by name: "euler" (eq. 28), "rk2" (midpoint), "jfnk" (§2.4.3), "bfgs" (eq. 35, dense),
-/// "lbfgs" (limited-memory quasi-Newton). Unknown names throw InputError.
+/// "lbfgs" (limited-memory quasi-Newton), "anderson" (Anderson acceleration of the same implicit update).
+/// Unknown names throw InputError.
 std::unique_ptr<MembraneIntegrator> make_integrator(const std::string& name, const SolverSettings& settings);
 
 /// The accepted names, for error messages and documentation.

@@ -73,14 +73,16 @@ void SnesIntegrator::setup(std::size_t n) {
     IMMERSE_PETSC(PCSetType(pc, PCNONE));  // the paper's GMRES is unpreconditioned
     IMMERSE_PETSC(KSPConvergedDefaultCreate(&ksp_default_ctx_));
     IMMERSE_PETSC(KSPSetConvergenceTest(ksp, &SnesIntegrator::gmres_converged, this, nullptr));
+  } else if (method_ == Method::Anderson) {
+    IMMERSE_PETSC(SNESSetType(snes_, SNESANDERSON));
+    set_option("-snes_anderson_m", settings_.anderson_memory);
+    set_option("-snes_anderson_beta", settings_.anderson_beta);
   } else {
     IMMERSE_PETSC(SNESSetType(snes_, SNESQN));
     IMMERSE_PETSC(SNESQNSetType(snes_, SNES_QN_LBFGS));
     IMMERSE_PETSC(SNESQNSetScaleType(snes_, SNES_QN_SCALE_NONE));  // H_0 = I: J = I - (dt/2) u' (32)
     IMMERSE_PETSC(SNESQNSetRestartType(snes_, SNES_QN_RESTART_NONE));
-    std::ostringstream m;
-    m << settings_.bfgs_memory;
-    IMMERSE_PETSC(PetscOptionsSetValue(options_, "-snes_qn_m", m.str().c_str()));
+    set_option("-snes_qn_m", settings_.bfgs_memory);
   }
   IMMERSE_PETSC(SNESGetLineSearch(snes_, &ls));
   IMMERSE_PETSC(SNESLineSearchSetType(ls, SNESLINESEARCHBASIC));  // full steps, eq. (34)
@@ -101,6 +103,22 @@ void SnesIntegrator::setup(std::size_t n) {
   if (!unused.empty())
     throw InputError("solver.petsc_options: PETSc does not know option " + unused + " for the '" + name() +
                      "' solver (see -help of PETSc's SNES, KSP and MatMFFD)");
+}
+
+void SnesIntegrator::set_option(const char* name, double value) {
+  std::ostringstream v;
+  v.precision(17);
+  v << value;
+  IMMERSE_PETSC(PetscOptionsSetValue(options_, name, v.str().c_str()));
+}
+
+std::string SnesIntegrator::name() const {
+  switch (method_) {
+    case Method::NewtonKrylov: return "jfnk";
+    case Method::LimitedMemoryBFGS: return "lbfgs";
+    case Method::Anderson: return "anderson";
+  }
+  return "";
 }
 
 PetscErrorCode SnesIntegrator::form_function(SNES, Vec x, Vec f, void* ctx) {

@@ -17,6 +17,16 @@
 // which is PETSc's matrix-free Jacobian with the Walker-Pernice parameter (MATMFFD_WP). Full Newton steps.
 // Method::LimitedMemoryBFGS ("lbfgs"): PETSc's limited-memory quasi-Newton (SNESQN, LBFGS) with H_0 = I, the
 // memory-light counterpart of eq. (35) that runs on 3D meshes where the dense matrix cannot (§2.4.2).
+// Method::Anderson ("anderson"): Anderson acceleration (PETSc's SNESANDERSON; Walker & Ni, SIAM J. Numer. Anal.
+// 49 (2011) 1715) of the fixed-point map X -> X - beta g(X), depth m (solver.anderson_memory, _beta):
+//
+//   X^(k+1) = sum_i a_i (X^(i) - beta g(X^(i))),   i = k-m..k,   the a_i (sum 1) minimizing || sum_i a_i g(X^(i)) ||.
+//
+// Every evaluation of g is one fluid solve and each one both tests convergence and adds a direction, whereas a
+// Newton step of JFNK spends its last evaluation on the test alone: on a residual that is nearly linear and whose
+// Jacobian J = I - (dt/2) dU/dX has its spectrum close to 1 on the error left by the initial guess (soft cells:
+// §4.4 at mu0 = 10 uN/m) that saves about one solve per step. Stiff membranes (J's spectrum far from 1) make the
+// mixed fixed-point steps diverge: there JFNK is the robust choice (docs/performance.md, "Session 11").
 //
 // Positions are measured in the operator's length scale inside the solver, so that eq. (37)'s perturbation is
 // relative to the geometry whatever the physical units (numerics notes: keep the norms scaled).
@@ -33,19 +43,21 @@ namespace immerse {
 
 class SnesIntegrator final : public MembraneIntegrator {
  public:
-  enum class Method { NewtonKrylov, LimitedMemoryBFGS };
+  enum class Method { NewtonKrylov, LimitedMemoryBFGS, Anderson };
   SnesIntegrator(Method method, const SolverSettings& settings);
   ~SnesIntegrator() override;
   SnesIntegrator(const SnesIntegrator&) = delete;
   SnesIntegrator& operator=(const SnesIntegrator&) = delete;
 
   StepStats step(CoupledOperator& op, double dt) override;
-  std::string name() const override { return method_ == Method::NewtonKrylov ? "jfnk" : "lbfgs"; }
+  std::string name() const override;
   /// Creates the PETSc solver with solver.petsc_options applied; an option PETSc rejects is an InputError.
   void prepare(std::size_t unknowns) override;
 
  private:
   void setup(std::size_t n);
+  // Sets a PETSc option of this solver (its private options database) from a setting.
+  void set_option(const char* name, double value);
   void destroy();
   static PetscErrorCode form_function(SNES, Vec x, Vec f, void* ctx);
   static PetscErrorCode converged(SNES, PetscInt it, PetscReal xnorm, PetscReal snorm, PetscReal fnorm,

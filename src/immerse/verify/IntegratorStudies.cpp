@@ -158,14 +158,15 @@ std::vector<Check> stability(bool quick) {
   return checks;
 }
 
-// The same step from the same state, solved by JFNK, the dense BFGS of eq. (35) and limited-memory BFGS.
+// The same step from the same state, solved by JFNK, the dense BFGS of eq. (35), limited-memory BFGS and Anderson
+// acceleration.
 std::vector<Check> solver_agreement(bool quick) {
   const int n = quick ? 16 : 32, level = quick ? 2 : 3;
   SolverSettings s;
   s.newton_rtol = 1e-10;
   std::vector<std::vector<double>> X;
   std::vector<int> its;
-  for (const char* scheme : {"jfnk", "bfgs", "lbfgs"}) {
+  for (const char* scheme : {"jfnk", "bfgs", "lbfgs", "anderson"}) {
     OscillatingMembrane exp(n, level, 0.01);
     auto jfnk = make_integrator("jfnk", s);
     exp.run_to(*jfnk, 2.0 / n, 1.0 / n);  // two identical JFNK steps first, so the third has history
@@ -183,6 +184,8 @@ std::vector<Check> solver_agreement(bool quick) {
   };
   return {{"||X_bfgs - X_jfnk|| / ||X|| (Newton tolerance 1e-10)", rel(X[1], X[0]), "<=", 1e-9},
           {"||X_lbfgs - X_jfnk|| / ||X||", rel(X[2], X[0]), "<=", 1e-9},
+          {"||X_anderson - X_jfnk|| / ||X||", rel(X[3], X[0]), "<=", 1e-9},
+          {"Anderson iterations for the step", double(its[3]), "<=", 20},
           {"dense BFGS iterations for the step", double(its[1]), "<=", 20},
           {"L-BFGS iterations for the step", double(its[2]), "<=", 20}};
 }
@@ -223,7 +226,7 @@ std::vector<Study> integrator_studies() {
       {"theta_ringing",
        "§4.1 at dt = 32dx: the trapezoidal rule rings (stiff modes not damped), backward Euler (theta = 1) does not",
        theta_ringing},
-      {"quasi_newton_agreement", "§2.4.2-2.4.3: dense BFGS (eq. 35), L-BFGS and JFNK reach the same X^{n+1}",
+      {"quasi_newton_agreement", "§2.4.2-2.4.3: dense BFGS (eq. 35), L-BFGS, Anderson acceleration and JFNK reach the same X^{n+1}",
        solver_agreement},
   };
 }
