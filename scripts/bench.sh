@@ -37,11 +37,12 @@ if [[ -z "$filter" ]]; then
   echo "running bench_oscillating --quick ..." >&2
   build/release/bench/bench_oscillating --quick >"$out/bench_oscillating.txt" 2>&1
   echo "running bench_channel --quick ..." >&2
-  build/release/bench/bench_channel --quick --rk2-budget 600 >"$out/bench_channel_quick.txt" 2>&1
+  build/release/bench/bench_channel --quick --implicit jfnk,anderson --rk2-budget 600 \
+    >"$out/bench_channel_quick.txt" 2>&1
 fi
 if [[ $paper == 1 ]]; then
   echo "running bench_channel (paper size) ..." >&2
-  build/release/bench/bench_channel >"$out/bench_channel.txt" 2>&1
+  build/release/bench/bench_channel --implicit jfnk,anderson >"$out/bench_channel.txt" 2>&1
 fi
 echo "load average $(cut -d' ' -f1-3 /proc/loadavg) at end" | tee -a "$out/machine.txt"
 /usr/bin/python3 scripts/bench_table.py "$out"
