@@ -2,7 +2,7 @@
 // grid, 10,242 nodes per cell), the paper's performance claim (JFNK at dt = 4.5e-4 s to t = 0.05 s in 22 min, 43
 // times faster than explicit RK2, whose largest stable step was 1.875e-6 s). Measures, in this one run:
 //   - the implicit scheme (JFNK, or each scheme --implicit lists) at the scenario's dt to its end time: wall time,
-//     fluid solves, Newton (Anderson) and GMRES iterations per step (a rejected attempt's solves count in its step;
+//     fluid solves, nonlinear (Newton or Anderson) and GMRES iterations per step (a rejected attempt's solves count in its step;
 //     the adaptive step then advances less than dt, and wall times are scaled by the time actually simulated);
 //   - explicit midpoint RK2: its largest stable dt, the largest step at which a run reaches the end time without a
 //     blow-up (Simulation::advance reports a non-finite position or velocity, or a node faster than 4 mm/s, 11 times
@@ -159,7 +159,7 @@ int main(int argc, char** argv) {
   long jfnk_steps = 0;
   double rk2_budget = 3600, rk2_from = 0;
   std::vector<std::string> implicit{"jfnk"};
-  CLI::App app{"§4.4 whole-run benchmark: JFNK against explicit RK2 (bench/bench_channel.cpp)"};
+  CLI::App app{"§4.4 whole-run benchmark: the implicit schemes against explicit RK2 (bench/bench_channel.cpp)"};
   app.add_flag("--quick", quick, "rbc_channel_quick.toml (48 x 96 x 24, 642-node cells) instead of rbc_channel.toml");
   app.add_option("--implicit", implicit, "implicit schemes to time against the explicit run, comma-separated")
       ->delimiter(',')
@@ -212,7 +212,13 @@ int measure(const std::string& file, const std::vector<std::string>& implicit, l
   std::vector<Timed> timed;
   for (const std::string& scheme : implicit) {
     const std::string label = scheme == "jfnk" ? "JFNK" : scheme == "anderson" ? "Anderson" : "L-BFGS";
-    const Cost j = run(channel_config(file, scheme, 0), jfnk_steps);
+    const Cost j = [&] {
+      try {
+        return run(channel_config(file, scheme, 0), jfnk_steps);
+      } catch (const SimulationError& e) {
+        throw SimulationError(label + ": " + e.what());
+      }
+    }();
     timed.push_back({label, j.scaled_to(T)});
     std::printf("%s: %ld steps in %.1f s (%.3f s/step), per step %.2f fluid solves, %.2f %s, %.2f GMRES%s\n",
                 label.c_str(), j.steps, j.seconds, j.per_step(), j.solves / double(j.steps),

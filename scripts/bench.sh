@@ -4,7 +4,7 @@
 # build/release/bench/results/ (Google Benchmark JSON, and the text of the whole-run benchmarks).
 #   bash scripts/bench.sh              all benchmarks (whole runs bench_oscillating and bench_channel at their --quick
 #                                      size, the latter's explicit probes limited to 10 minutes: about 15 minutes)
-#   bash scripts/bench.sh --paper-size all, and §4.4 at the paper's size too (bench_channel: up to 65 more minutes,
+#   bash scripts/bench.sh --paper-size all, and §4.4 at the paper's size too (bench_channel: up to 67 more minutes,
 #                                      most of it explicit RK2 runs to t = 0.05 s, limited by --rk2-budget 3600)
 #   bash scripts/bench.sh FILTER       only the Google Benchmark cases matching the regex FILTER
 # Timings are wall-clock; the ratios are taken inside one program (fastest repetitions of the kernel and of its

@@ -111,7 +111,7 @@ TEST(Integrators, BackwardEulerRemovesTheRingingOfStiffModes) {
   EXPECT_LT(std::abs(b.positions()[0] - 1.0), 1e-3 * X0);
 }
 
-TEST(Integrators, QuasiNewtonAndJfnkReachTheSameStep) {
+TEST(Integrators, QuasiNewtonAndAndersonAndJfnkReachTheSameStep) {
   SolverSettings s;
   s.newton_rtol = 1e-12;
   auto a = make_toy(), b = make_toy(), c = make_toy(), d = make_toy();
@@ -182,6 +182,38 @@ TEST(Integrators, BadNamesAndSettingsAreRejected) {
     FAIL() << "unknown PETSc option accepted";
   } catch (const InputError& e) {
     EXPECT_NE(std::string(e.what()).find("-snes_no_such_option"), std::string::npos) << e.what();
+  }
+}
+
+// solver.petsc_options wins over the anderson_* settings it repeats; options of JFNK's KSP or matrix-free Jacobian are
+// reported as unused by Anderson (it has neither).
+TEST(Integrators, AndersonTakesItsPetscOptionsOverItsSettings) {
+  // Three steps with beta from the setting, or from solver.petsc_options: the positions reached (bitwise).
+  auto positions = [](double beta, const std::string& options) {
+    SolverSettings s;
+    s.anderson_beta = beta;
+    s.petsc_options = options;
+    auto op = make_toy();
+    auto anderson = make_integrator("anderson", s);
+    for (int i = 0; i < 3; ++i) {
+      const auto st = anderson->step(op, 0.05);
+      EXPECT_TRUE(st.converged) << st.failure;
+    }
+    return std::vector<double>(op.positions().begin(), op.positions().end());
+  };
+  const auto reference = positions(0.85, "");
+  EXPECT_NE(positions(0.3, ""), reference);  // beta changes the iterates, so the accepted positions
+  EXPECT_EQ(positions(0.3, "-snes_anderson_beta 0.85"), reference);
+  SolverSettings s;
+  s.petsc_options = "-ksp_gmres_restart 50";
+  auto op = make_toy();
+  auto anderson = make_integrator("anderson", s);
+  try {
+    anderson->step(op, 0.05);
+    FAIL() << "a KSP option accepted by the Anderson solver";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("'anderson' solver does not use option -ksp_gmres_restart"), std::string::npos)
+        << e.what();
   }
 }
 

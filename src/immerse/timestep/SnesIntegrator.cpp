@@ -85,7 +85,7 @@ void SnesIntegrator::setup(std::size_t n) {
     set_option("-snes_qn_m", settings_.bfgs_memory);
   }
   IMMERSE_PETSC(SNESGetLineSearch(snes_, &ls));
-  IMMERSE_PETSC(SNESLineSearchSetType(ls, SNESLINESEARCHBASIC));  // full steps, eq. (34)
+  IMMERSE_PETSC(SNESLineSearchSetType(ls, SNESLINESEARCHBASIC));  // full steps: eq. (34) (Anderson takes none)
   IMMERSE_PETSC(SNESSetSolution(snes_, x_));
   IMMERSE_PETSC(PetscOptionsHasName(options_, nullptr, "-ksp_atol", &user_atol_));
   try {
@@ -100,12 +100,18 @@ void SnesIntegrator::setup(std::size_t n) {
   std::string unused;
   for (PetscInt i = 0; i < left; ++i) unused += (unused.empty() ? "-" : ", -") + std::string(names[i]);
   IMMERSE_PETSC(PetscOptionsLeftRestore(options_, &left, &names, &values));
-  if (!unused.empty())
+  if (unused.empty()) return;
+  if (method_ == Method::NewtonKrylov)
     throw InputError("solver.petsc_options: PETSc does not know option " + unused + " for the '" + name() +
                      "' solver (see -help of PETSc's SNES, KSP and MatMFFD)");
+  throw InputError("solver.petsc_options: the '" + name() + "' solver does not use option " + unused +
+                   " (it has no KSP or matrix-free Jacobian; see -help of PETSc's SNES)");
 }
 
 void SnesIntegrator::set_option(const char* name, double value) {
+  PetscBool given = PETSC_FALSE;  // solver.petsc_options wins over the setting
+  IMMERSE_PETSC(PetscOptionsHasName(options_, nullptr, name, &given));
+  if (given) return;
   std::ostringstream v;
   v.precision(17);
   v << value;

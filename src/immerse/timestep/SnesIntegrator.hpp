@@ -56,7 +56,8 @@ class SnesIntegrator final : public MembraneIntegrator {
 
  private:
   void setup(std::size_t n);
-  // Sets a PETSc option of this solver (its private options database) from a setting.
+  // Sets a PETSc option of this solver (its private options database) from a setting, unless solver.petsc_options
+  // gives it.
   void set_option(const char* name, double value);
   void destroy();
   static PetscErrorCode form_function(SNES, Vec x, Vec f, void* ctx);

@@ -185,7 +185,7 @@ std::vector<Check> solver_agreement(bool quick) {
   return {{"||X_bfgs - X_jfnk|| / ||X|| (Newton tolerance 1e-10)", rel(X[1], X[0]), "<=", 1e-9},
           {"||X_lbfgs - X_jfnk|| / ||X||", rel(X[2], X[0]), "<=", 1e-9},
           {"||X_anderson - X_jfnk|| / ||X||", rel(X[3], X[0]), "<=", 1e-9},
-          {"Anderson iterations for the step", double(its[3]), "<=", 20},
+          {"Anderson iterations for the step", double(its[3]), "<=", 8},
           {"dense BFGS iterations for the step", double(its[1]), "<=", 20},
           {"L-BFGS iterations for the step", double(its[2]), "<=", 20}};
 }
