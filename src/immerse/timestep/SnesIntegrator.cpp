@@ -105,7 +105,8 @@ void SnesIntegrator::setup(std::size_t n) {
     throw InputError("solver.petsc_options: PETSc does not know option " + unused + " for the '" + name() +
                      "' solver (see -help of PETSc's SNES, KSP and MatMFFD)");
   throw InputError("solver.petsc_options: the '" + name() + "' solver does not use option " + unused +
-                   " (it has no KSP or matrix-free Jacobian; see -help of PETSc's SNES)");
+                   " (PETSc does not know it, or it belongs to JFNK's KSP or matrix-free Jacobian; see -help of "
+                   "PETSc's SNES)");
 }
 
 void SnesIntegrator::set_option(const char* name, double value) {
