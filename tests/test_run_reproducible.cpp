@@ -21,17 +21,22 @@ std::vector<std::string> threaded_sets(int steps) {
   return s;
 }
 
-int run(const fs::path& out, int steps, int threads, const fs::path& restart = {}) {
-  const auto args = run_args(scenario_file("oscillating_membrane_quick.toml"), out, threaded_sets(steps), restart);
+int run(const fs::path& out, int steps, int threads, const fs::path& restart = {}, const std::string& scheme = "jfnk") {
+  auto sets = threaded_sets(steps);
+  sets.push_back("time.scheme=" + scheme);
+  const auto args = run_args(scenario_file("oscillating_membrane_quick.toml"), out, sets, restart);
   const auto r = run_immerse(args, out.string() + "_log", {"OMP_NUM_THREADS=" + std::to_string(threads)});
   EXPECT_EQ(r.err, "");
   return r.status;
 }
 
-TEST(Reproducibility, RunsWithOneAndTwoThreadsInSeparateProcessesAreBitwiseIdentical) {
+// For each implicit solver of the 3D runs: JFNK (the paper's) and Anderson acceleration.
+class ThreadCount : public ::testing::TestWithParam<std::string> {};
+
+TEST_P(ThreadCount, RunsWithOneAndTwoThreadsInSeparateProcessesAreBitwiseIdentical) {
   ScratchDir dir("reproducible");
-  ASSERT_EQ(run(dir / "one", kSteps, 1), 0);
-  ASSERT_EQ(run(dir / "two", kSteps, 2), 0);
+  ASSERT_EQ(run(dir / "one", kSteps, 1, {}, GetParam()), 0);
+  ASSERT_EQ(run(dir / "two", kSteps, 2, {}, GetParam()), 0);
   const auto one = io::Checkpoint::read(dir / "one" / "checkpoint.h5");
   const auto two = io::Checkpoint::read(dir / "two" / "checkpoint.h5");
   EXPECT_EQ(one.get_int("step"), kSteps);
@@ -40,6 +45,9 @@ TEST(Reproducibility, RunsWithOneAndTwoThreadsInSeparateProcessesAreBitwiseIdent
   EXPECT_EQ(rows.size(), std::size_t(kSteps + 2));
   EXPECT_EQ(rows, without_wall_clock(read_csv(dir / "two" / "diagnostics.csv")));
 }
+
+INSTANTIATE_TEST_SUITE_P(Reproducibility, ThreadCount, ::testing::Values("jfnk", "anderson"),
+                         [](const auto& p) { return p.param; });
 
 TEST(Reproducibility, RestartInANewProcessContinuesBitwise) {
   ScratchDir dir("reproducible");
