@@ -2,8 +2,9 @@
 // grid, 10,242 nodes per cell), the paper's performance claim (JFNK at dt = 4.5e-4 s to t = 0.05 s in 22 min, 43
 // times faster than explicit RK2, whose largest stable step was 1.875e-6 s). Measures, in this one run:
 //   - the implicit scheme (JFNK, or each scheme --implicit lists) at the scenario's dt to its end time: wall time,
-//     fluid solves, nonlinear (Newton or Anderson) and GMRES iterations per step (a rejected attempt's solves count in its step;
-//     the adaptive step then advances less than dt, and wall times are scaled by the time actually simulated);
+//     fluid solves, nonlinear (Newton or Anderson) and GMRES iterations per step (a rejected attempt's solves count
+//     in its step; the adaptive step then advances less than dt, and wall times are scaled by the time actually
+//     simulated);
 //   - explicit midpoint RK2: its largest stable dt, the largest step at which a run reaches the end time without a
 //     blow-up (Simulation::advance reports a non-finite position or velocity, or a node faster than 4 mm/s, 11 times
 //     the empty duct's centre velocity). Every probe runs to the end time: the scheme's instability can grow for

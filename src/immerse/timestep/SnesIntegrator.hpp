@@ -25,8 +25,9 @@
 // Every evaluation of g is one fluid solve and each one both tests convergence and adds a direction, whereas a
 // Newton step of JFNK spends its last evaluation on the test alone: on a residual that is nearly linear and whose
 // Jacobian J = I - (dt/2) dU/dX has its spectrum close to 1 on the error left by the initial guess (soft cells:
-// §4.4 at mu0 = 10 uN/m) that saves about one solve per step. Stiff membranes (J's spectrum far from 1) make the
-// mixed fixed-point steps diverge: there JFNK is the robust choice (docs/performance.md, "Session 11").
+// §4.4 at mu0 = 10 uN/m) that saves about one solve per step. On stiff membranes (J's spectrum far from 1) the
+// fixed-point step amplifies the stiff modes and the mixing converges slowly or not at all: there JFNK is the robust
+// choice (docs/performance.md, "Session 11").
 //
 // Positions are measured in the operator's length scale inside the solver, so that eq. (37)'s perturbation is
 // relative to the geometry whatever the physical units (numerics notes: keep the norms scaled).

@@ -226,7 +226,8 @@ std::vector<Study> integrator_studies() {
       {"theta_ringing",
        "§4.1 at dt = 32dx: the trapezoidal rule rings (stiff modes not damped), backward Euler (theta = 1) does not",
        theta_ringing},
-      {"quasi_newton_agreement", "§2.4.2-2.4.3: dense BFGS (eq. 35), L-BFGS, Anderson acceleration and JFNK reach the same X^{n+1}",
+      {"quasi_newton_agreement",
+       "§2.4.2-2.4.3: dense BFGS (eq. 35), L-BFGS, Anderson acceleration and JFNK reach the same X^{n+1}",
        solver_agreement},
   };
 }
