@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 #include <omp.h>
 
+#include <algorithm>
 #include <cmath>
 #include <iostream>
 #include <numeric>
@@ -203,6 +204,30 @@ TEST(ErrorRecurrence, RestoreOfItsErrorsIsBitwise) {
   }
   EXPECT_THROW(s.restore(std::vector<double>(61, 1.0), 60, 0.1), InputError);
   EXPECT_THROW(s.restore(std::vector<double>(540, 1.0), 60, 0.1), InputError);  // more than eight errors
+}
+
+// The Gram matrices are kept from step to step (each new error's dot products computed once, the oldest error's
+// dropped with it): predictions made every step, by blocks that change now and then, are bitwise those of a
+// recurrence rebuilt from the same errors, whose matrices are computed afresh.
+TEST(ErrorRecurrence, KeptGramMatricesGiveThePredictionsOfFreshOnes) {
+  const std::vector<std::size_t> two{0, 90, 150}, three{0, 40, 90, 150};
+  ErrorRecurrence kept;
+  int compared = 0;
+  for (int k = 0; k < 16; ++k) {
+    const auto& offsets = (k / 5) % 2 == 0 ? two : three;
+    if (k > 0) {
+      ErrorRecurrence fresh;
+      fresh.restore(kept.errors(), 150, kept.dt());
+      const auto p = prediction(kept, 0.1, 150, offsets);
+      EXPECT_EQ(p, prediction(fresh, 0.1, 150, offsets)) << "step " << k;
+      compared += std::ranges::any_of(p, [](double x) { return x != 0; });
+    }
+    auto e = modes(k, {0.9, 0.6, -0.4, -0.9}, 150, 70);
+    const auto noise = random_vector(150, 200 + static_cast<unsigned>(k));
+    for (std::size_t i = 0; i < e.size(); ++i) e[i] += 1e-3 * noise[i];
+    kept.record(0.1, e);
+  }
+  EXPECT_GE(compared, 10);  // most steps predict something
 }
 
 // The integrators keep the errors of extrapolated guesses over equal steps only: none after the first step (its

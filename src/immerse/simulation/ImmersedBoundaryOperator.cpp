@@ -24,6 +24,18 @@ void timed(double& seconds, F&& f) {
   seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
 
+/// dst = src (resized), copied by the threads: the trial state's positions and velocities are saved at every
+/// evaluation of the implicit residual.
+template <class T>
+void parallel_assign(std::span<const T> src, std::vector<T>& dst) {
+  dst.resize(src.size());
+  const long n = static_cast<long>(src.size());
+  T* const d = dst.data();
+  const T* const s = src.data();
+#pragma omp parallel for schedule(static)
+  for (long i = 0; i < n; ++i) d[i] = s[i];
+}
+
 }  // namespace
 
 ImmersedBoundaryOperator::ImmersedBoundaryOperator(NavierStokesSolver& fluid, IBCoupler& coupler,
@@ -119,11 +131,8 @@ void ImmersedBoundaryOperator::trial_velocity(std::span<const double> Xf, double
     coupler_.interpolate_velocity(trial_.u, nodes(Xi), {reinterpret_cast<Vec3*>(U.data()), U.size() / 3});
   });
   trial_U_valid_ = Xi.data() == Xf.data() && Xi.size() == Xf.size();
-  if (trial_U_valid_) {
-    const auto u = nodes(U);
-    trial_U_.assign(u.begin(), u.end());
-  }
-  trial_X_.assign(Xf.begin(), Xf.end());
+  if (trial_U_valid_) parallel_assign<Vec3>(nodes(U), trial_U_);
+  parallel_assign(Xf, trial_X_);
 }
 
 void ImmersedBoundaryOperator::committed_velocity(std::span<const double> Xi, std::span<double> U) {

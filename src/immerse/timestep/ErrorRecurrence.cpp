@@ -9,17 +9,30 @@
 
 namespace immerse {
 
-ErrorRecurrence::Gram ErrorRecurrence::gram(std::size_t begin, std::size_t end) const {
-  Gram G{};
-  const std::size_t m = e_.size();
-  std::array<const double*, kDepth> e{};
-  for (std::size_t i = 0; i < m; ++i) e[i] = e_[i].data();
-  for (std::size_t k = begin; k < end; ++k)  // one pass over the block, each sum in the order of k
-    for (std::size_t i = 0; i < m; ++i)
-      for (std::size_t j = 0; j <= i; ++j) G[i][j] += e[i][k] * e[j][k];
-  for (std::size_t i = 0; i < m; ++i)
-    for (std::size_t j = 0; j < i; ++j) G[j][i] = G[i][j];
-  return G;
+void ErrorRecurrence::update_grams(const std::vector<std::size_t>& b) const {
+  if (b != gram_blocks_) {
+    gram_blocks_ = b;
+    gram_rows_ = 0;
+  }
+  const std::size_t m = e_.size(), nblocks = b.size() - 1;
+  if (gram_rows_ == m) return;
+  grams_.resize(nblocks);
+#pragma omp parallel for schedule(dynamic)
+  for (std::size_t blk = 0; blk < nblocks; ++blk) {
+    Gram& G = grams_[blk];
+    for (std::size_t i = gram_rows_; i < m; ++i) {
+      const double* const ei = e_[i].data();
+      std::array<double, kDepth> row{};
+      for (std::size_t j = 0; j <= i; ++j) {
+        const double* const ej = e_[j].data();
+        double s = 0;
+        for (std::size_t k = b[blk]; k < b[blk + 1]; ++k) s += ei[k] * ej[k];
+        row[j] = s;
+      }
+      for (std::size_t j = 0; j <= i; ++j) G[i][j] = G[j][i] = row[j];
+    }
+  }
+  gram_rows_ = m;
 }
 
 ErrorRecurrence::Fit ErrorRecurrence::fit(const Gram& G, std::size_t m, std::size_t unknowns) {
@@ -82,8 +95,9 @@ std::vector<std::size_t> ErrorRecurrence::blocks(std::span<const std::size_t> of
 int ErrorRecurrence::terms(double dt, std::span<const std::size_t> offsets) const {
   if (dt != dt_ || e_.empty()) return 0;
   const auto b = blocks(offsets);
+  update_grams(b);
   int most = 0;
-  for (std::size_t k = 0; k + 1 < b.size(); ++k) most = std::max(most, next_fit(gram(b[k], b[k + 1]), b[k + 1] - b[k]).terms);
+  for (std::size_t k = 0; k + 1 < b.size(); ++k) most = std::max(most, next_fit(grams_[k], b[k + 1] - b[k]).terms);
   return most;
 }
 
@@ -91,11 +105,12 @@ void ErrorRecurrence::predict(double dt, std::span<double> X, std::span<const st
   if (dt != dt_ || e_.empty()) return;
   if (X.size() != e_.back().size()) throw std::logic_error("ErrorRecurrence: the number of unknowns changed");
   const auto b = blocks(offsets);
+  update_grams(b);
   const std::size_t m = e_.size(), nblocks = b.size() - 1;
   // One block per thread, each summed in order: the prediction does not depend on the number of threads.
 #pragma omp parallel for schedule(dynamic)
   for (std::size_t k = 0; k < nblocks; ++k) {
-    const Fit f = next_fit(gram(b[k], b[k + 1]), b[k + 1] - b[k]);
+    const Fit f = next_fit(grams_[k], b[k + 1] - b[k]);
     for (int p = 0; p < f.terms; ++p)
       for (std::size_t i = b[k]; i < b[k + 1]; ++i) X[i] += f.a[p] * e_[m - 1 - p][i];
   }
@@ -104,13 +119,24 @@ void ErrorRecurrence::predict(double dt, std::span<double> X, std::span<const st
 void ErrorRecurrence::record(double dt, std::span<const double> error) {
   if (dt != dt_ || (!e_.empty() && e_.back().size() != error.size())) clear();
   dt_ = dt;
-  if (e_.size() == kDepth) e_.pop_front();
-  e_.emplace_back(error.begin(), error.end());
+  std::vector<double> v;
+  if (e_.size() == kDepth) {  // the oldest error's storage takes the new one
+    v = std::move(e_.front());
+    e_.pop_front();
+    for (Gram& G : grams_) {  // its row and column leave the Gram matrices
+      for (std::size_t i = 1; i < kDepth; ++i)
+        for (std::size_t j = 1; j < kDepth; ++j) G[i - 1][j - 1] = G[i][j];
+    }
+    gram_rows_ = gram_rows_ > 0 ? gram_rows_ - 1 : 0;
+  }
+  v.assign(error.begin(), error.end());
+  e_.push_back(std::move(v));
 }
 
 void ErrorRecurrence::clear() {
   e_.clear();
   dt_ = 0;
+  gram_rows_ = 0;
 }
 
 std::vector<double> ErrorRecurrence::errors() const {

@@ -55,8 +55,10 @@ class ErrorRecurrence {
     std::array<double, kMaxTerms> a{};
   };
   using Gram = std::array<std::array<double, kDepth>, kDepth>;
-  // Dot products of the stored errors over [begin, end).
-  Gram gram(std::size_t begin, std::size_t end) const;
+  // Brings the Gram matrices of the stored errors over each block of b up to date: each error's dot products with
+  // the errors before it are computed once, when it is first needed, and kept while both stay stored (each sum in
+  // the order of the unknowns, so the entries do not depend on when they were computed or on the thread count).
+  void update_grams(const std::vector<std::size_t>& b) const;
   // The fit that predicts e_[m] from e_[m-1], e_[m-2], ... (m <= number stored) in a block of `unknowns`.
   static Fit fit(const Gram& G, std::size_t m, std::size_t unknowns);
   // The fit for the next error in a block, or none (the rules above).
@@ -64,6 +66,9 @@ class ErrorRecurrence {
   std::vector<std::size_t> blocks(std::span<const std::size_t> offsets) const;
   std::deque<std::vector<double>> e_;
   double dt_ = 0;
+  mutable std::vector<std::size_t> gram_blocks_;  // the blocks grams_ belongs to
+  mutable std::vector<Gram> grams_;               // per block, over e_[0 .. gram_rows_)
+  mutable std::size_t gram_rows_ = 0;
 };
 
 }  // namespace immerse

@@ -43,7 +43,10 @@ void MembraneIntegrator::initial_guess(const ThetaResidual& g, SolverSettings::I
 
 void MembraneIntegrator::remember(const CoupledOperator& op, double dt, std::span<const double> X) {
   if (!extrapolated_.empty() && X.size() == extrapolated_.size()) {
-    for (std::size_t i = 0; i < X.size(); ++i) extrapolated_[i] = X[i] - extrapolated_[i];
+    const long n = static_cast<long>(X.size());
+    double* const e = extrapolated_.data();
+#pragma omp parallel for schedule(static)
+    for (long i = 0; i < n; ++i) e[i] = X[i] - e[i];
     errors_.record(dt, extrapolated_);
   } else {
     errors_.clear();

@@ -208,10 +208,12 @@ StepStats SnesIntegrator::step(CoupledOperator& op, double dt) {
 
   PetscScalar* xs;
   IMMERSE_PETSC(VecGetArray(x_, &xs));
+  initial_guess(residual, settings_.initial_guess, X_);  // X_: the positions of the last evaluation, reused
   {
-    std::vector<double> X0(n_);
-    initial_guess(residual, settings_.initial_guess, X0);
-    for (std::size_t i = 0; i < n_; ++i) xs[i] = X0[i] / scale_;
+    const long n = static_cast<long>(n_);
+    const double* const X = X_.data();
+#pragma omp parallel for schedule(static)
+    for (long i = 0; i < n; ++i) xs[i] = X[i] / scale_;
   }
   IMMERSE_PETSC(VecRestoreArray(x_, &xs));
   if (method_ == Method::NewtonKrylov && !user_atol_) {  // GMRES's absolute stop: 0.9 of the Newton tolerance

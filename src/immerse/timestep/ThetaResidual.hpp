@@ -36,11 +36,14 @@ class ThetaResidual {
   void initial_guess(const std::vector<double>& previous, double previous_dt, std::span<double> X0) const {
     const auto Xn = op_.positions();
     const auto Un = op_.node_velocity();
+    const long n = static_cast<long>(Xn.size());
     if (previous.size() == Xn.size() && previous_dt > 0) {
       const double r = dt_ / previous_dt;
-      for (std::size_t i = 0; i < Xn.size(); ++i) X0[i] = Xn[i] + r * (Xn[i] - previous[i]);
+#pragma omp parallel for schedule(static)
+      for (long i = 0; i < n; ++i) X0[i] = Xn[i] + r * (Xn[i] - previous[i]);
     } else {
-      for (std::size_t i = 0; i < Xn.size(); ++i) X0[i] = Xn[i] + dt_ * Un[i];
+#pragma omp parallel for schedule(static)
+      for (long i = 0; i < n; ++i) X0[i] = Xn[i] + dt_ * Un[i];
     }
   }
   CoupledOperator& op() { return op_; }
