@@ -15,6 +15,9 @@
 //     the smallest one tried, so the explicit run takes more than its step count times the measured time per step;
 //   - the ratio explicit / implicit of the wall times to the end time (for each implicit scheme), and the peak
 //     resident memory;
+//   - what sets the ratio: an implicit step's residual evaluations (each a force evaluation, spreading, a fluid step
+//     and an interpolation) and its other work against an RK2 step, and the ratio with no other work, with three
+//     evaluations per step (a Newton step's least at the paper's tolerance) and the evaluations 43 would allow;
 //   - for each scheme, where the time goes: membrane forces, spreading, fluid, interpolation, the rest (the
 //     nonlinear solver's vector work, stability checks), from the operator's timers (StepTimings).
 // Usage: bench_channel [--quick] [--implicit S,...] [--jfnk-steps N] [--jfnk-only] [--rk2-budget S] [--rk2-from DT]
@@ -208,7 +211,11 @@ int measure(const std::string& file, const std::vector<std::string>& implicit, l
 
   struct Timed {
     std::string label;
-    double to_end;  // wall time to t_end
+    double to_end;          // wall time to t_end
+    double steps_to_end;    // at the mean accepted step
+    double evaluation;      // seconds per residual evaluation: forces, spreading, fluid step, interpolation
+    double solves;          // residual evaluations (fluid solves) per step
+    double other;           // seconds per step outside the evaluations: the solver's own work, guess, checks
   };
   std::vector<Timed> timed;
   for (const std::string& scheme : implicit) {
@@ -220,7 +227,8 @@ int measure(const std::string& file, const std::vector<std::string>& implicit, l
         throw SimulationError(label + ": " + e.what());
       }
     }();
-    timed.push_back({label, j.scaled_to(T)});
+    timed.push_back({label, j.scaled_to(T), T / (j.simulated / double(j.steps)), j.parts.total() / j.solves,
+                     j.solves / double(j.steps), (j.seconds - j.parts.total()) / double(j.steps)});
     std::printf("%s: %ld steps in %.1f s (%.3f s/step), per step %.2f fluid solves, %.2f %s, %.2f GMRES%s\n",
                 label.c_str(), j.steps, j.seconds, j.per_step(), j.solves / double(j.steps),
                 j.newton / double(j.steps), scheme == "jfnk" ? "Newton" : "nonlinear iterations",
@@ -282,6 +290,16 @@ int measure(const std::string& file, const std::vector<std::string>& implicit, l
                     t.label.c_str(), ratio, hi->dt, T / hi->dt * lo->cost.per_step() / t.to_end, ratio);
       else
         std::printf("ratio explicit / implicit (%s): at most %.1f (paper: 43)\n", t.label.c_str(), ratio);
+      // The ratio is RK2's run over (steps x (evaluations x their cost + other work)): what fewer evaluations or no
+      // other work would give, at this run's costs.
+      const double rk2 = lo->cost.seconds, per_eval = t.steps_to_end * t.evaluation;
+      std::printf("what sets it (%s): a step is %.2f residual evaluations of %.1f ms (forces, spreading, fluid, "
+                  "interpolation) + %.1f ms of other work; an RK2 step costs %.1f ms (%.2f evaluations); with no "
+                  "other work the ratio would be %.1f, with three evaluations and none %.1f; 43 needs at most %.2f "
+                  "evaluations per step and no other work\n",
+                  t.label.c_str(), t.solves, 1e3 * t.evaluation, 1e3 * t.other, 1e3 * lo->cost.per_step(),
+                  lo->cost.per_step() / t.evaluation, rk2 / (per_eval * t.solves), rk2 / (3 * per_eval),
+                  rk2 / (43 * per_eval));
     }
   } else if (hi) {
     const double steps = T / hi->dt, t_bound = steps * hi->cost.per_step();
