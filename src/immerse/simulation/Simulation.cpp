@@ -115,7 +115,7 @@ Simulation::Simulation(const io::Config& config)
   if (integrator_->name() == "bfgs" && op_->size() > DenseBfgs::max_unknowns)
     throw InputError("time.scheme = \"bfgs\": the dense quasi-Newton matrix of eq. (35) is limited to " +
                      std::to_string(DenseBfgs::max_unknowns) + " unknowns and this run has " +
-                     std::to_string(op_->size()) + " (use \"lbfgs\" or \"jfnk\")");
+                     std::to_string(op_->size()) + " (use \"jfnk\", \"anderson\" or \"lbfgs\")");
   integrator_->prepare(op_->size());
 }
 
