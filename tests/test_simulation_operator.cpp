@@ -137,6 +137,32 @@ TEST(ImmersedBoundaryOperator, NodeVelocityIsTakenOverOnlyFromATrialAtTheCommitt
   }
 }
 
+// The midpoint rule's velocity J(Xi) (u^n + u^{n+1}) / 2, one interpolation of the mean field, is the mean of the two
+// interpolations (J is linear in u) to round-off, from a committed state that is not at rest, for one fluid step.
+TEST(ImmersedBoundaryOperator, TrialMeanVelocityIsTheMeanOfTheCommittedAndTrialVelocities) {
+  Cells s;
+  auto op = s.make_operator();
+  const std::vector<double> X0v(op.positions().begin(), op.positions().end());
+  const auto X1 = shifted(X0v, 1e-2), X2 = shifted(X1, 1e-2), X3 = shifted(X2, 1e-2);
+  std::vector<double> U(op.size()), Un(op.size()), Um(op.size());
+  op.trial_velocity(X1, 1.0, X1, 0.1, U);
+  op.commit(X1, 0.1);
+  op.trial_velocity(X2, 1.0, X3, 0.1, U);
+  op.committed_velocity(X3, Un);
+  const std::size_t solves = op.fluid_solves();
+  op.trial_mean_velocity(X2, X3, 0.1, Um);
+  EXPECT_EQ(op.fluid_solves(), solves + 1);
+  EXPECT_TRUE(op.trial_matches(X2));
+  double largest = 0, error = 0, change = 0;
+  for (std::size_t i = 0; i < U.size(); ++i) {
+    largest = std::max(largest, std::abs(U[i]));
+    error = std::max(error, std::abs(Um[i] - 0.5 * (Un[i] + U[i])));
+    change = std::max(change, std::abs(U[i] - Un[i]));
+  }
+  EXPECT_GT(change, 0.1 * largest);
+  EXPECT_LT(error, 1e-14 * largest);
+}
+
 // The start force S(X^n) f(X^n) of the next step, seen through the trial velocity at X2 (theta = 1/2 mixes it in).
 // An implicit step ends with a trial at X^{n+1}; commit takes its S(X^{n+1}) f(X^{n+1}) over. Applied forces set
 // before or after the commit, and a commit at other positions than the last trial's, must not reuse it.

@@ -104,9 +104,9 @@ void ImmersedBoundaryOperator::membrane_force_density(std::span<const Vec3> X, F
   timed(timings_.spread, [&] { coupler_.spread_force(X, F_, f); });
 }
 
-void ImmersedBoundaryOperator::trial_velocity(std::span<const double> Xf, double theta, std::span<const double> Xi,
-                                              double dt, std::span<double> U) {
+void ImmersedBoundaryOperator::trial_step(std::span<const double> Xf, double theta, double dt) {
   trial_X_.clear();
+  trial_U_valid_ = false;
   if (theta < 1.0 && !start_valid_) {
     membrane_force_density(X_, force_start_);
     start_valid_ = true;
@@ -127,11 +127,33 @@ void ImmersedBoundaryOperator::trial_velocity(std::span<const double> Xf, double
     fluid_.step(prepared_, theta < 1.0 ? mixed_ : force_, trial_);
   });
   ++solves_;
+}
+
+void ImmersedBoundaryOperator::trial_velocity(std::span<const double> Xf, double theta, std::span<const double> Xi,
+                                              double dt, std::span<double> U) {
+  trial_step(Xf, theta, dt);
   timed(timings_.interpolate, [&] {
     coupler_.interpolate_velocity(trial_.u, nodes(Xi), {reinterpret_cast<Vec3*>(U.data()), U.size() / 3});
   });
   trial_U_valid_ = Xi.data() == Xf.data() && Xi.size() == Xf.size();
   if (trial_U_valid_) parallel_assign<Vec3>(nodes(U), trial_U_);
+  parallel_assign(Xf, trial_X_);
+}
+
+void ImmersedBoundaryOperator::trial_mean_velocity(std::span<const double> Xf, std::span<const double> Xi, double dt,
+                                                   std::span<double> U) {
+  trial_step(Xf, 1.0, dt);
+  timed(timings_.interpolate, [&] {
+    if (mean_[0].size() == 0) mean_ = FaceField(fluid_.grid());
+    for (int d = 0; d < 3; ++d) {
+      auto& m = mean_[d];
+      const auto& a = committed_.u[d];
+      const auto& b = trial_.u[d];
+#pragma omp parallel for
+      for (std::size_t i = 0; i < m.size(); ++i) m[i] = 0.5 * (a[i] + b[i]);
+    }
+    coupler_.interpolate_velocity(mean_, nodes(Xi), {reinterpret_cast<Vec3*>(U.data()), U.size() / 3});
+  });
   parallel_assign(Xf, trial_X_);
 }
 

@@ -40,6 +40,9 @@ class ImmersedBoundaryOperator final : public CoupledOperator {
   void trial_velocity(std::span<const double> Xf, double theta, std::span<const double> Xi, double dt,
                       std::span<double> U) override;
   void committed_velocity(std::span<const double> Xi, std::span<double> U) override;
+  /// One interpolation, of the mean field (u^n + u^{n+1}) / 2.
+  void trial_mean_velocity(std::span<const double> Xf, std::span<const double> Xi, double dt,
+                           std::span<double> U) override;
   bool trial_matches(std::span<const double> X) const override { return std::ranges::equal(X, trial_X_); }
   void commit(std::span<const double> X, double dt) override;
   std::size_t fluid_solves() const override { return solves_; }
@@ -69,6 +72,8 @@ class ImmersedBoundaryOperator final : public CoupledOperator {
   void nodal_force(std::size_t m, std::span<const Vec3> X);
   /// f = S(X) f(X) for all membranes.
   void membrane_force_density(std::span<const Vec3> X, FaceField& f);
+  /// The fluid step of a trial: trial_ = the step from committed_ driven by F^{n+1/2} of (Xf, theta).
+  void trial_step(std::span<const double> Xf, double theta, double dt);
 
   NavierStokesSolver& fluid_;
   IBCoupler& coupler_;
@@ -85,6 +90,7 @@ class ImmersedBoundaryOperator final : public CoupledOperator {
   bool start_valid_ = true;
   FaceField force_;             ///< S(Xf) f(Xf) of the last trial
   FaceField mixed_;             ///< F^{n+1/2} of the last trial (allocated by the first trial with theta < 1)
+  FaceField mean_;              ///< (u^n + u^{n+1}) / 2 of trial_mean_velocity (allocated by its first call)
   std::vector<double> trial_X_;  ///< the Xf of the last completed trial (empty when none can be reused at commit)
   std::vector<Vec3> trial_U_;    ///< J(Xi) u of the last trial, when trial_U_valid_ (it was interpolated at Xi = Xf)
   bool trial_U_valid_ = false;

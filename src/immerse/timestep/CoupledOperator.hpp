@@ -34,6 +34,16 @@ class CoupledOperator {
                               std::span<double> U) = 0;
   /// U = J(Xi) u^n for the committed fluid velocity.
   virtual void committed_velocity(std::span<const double> Xi, std::span<double> U) = 0;
+  /// The midpoint rule's velocity: the fluid step of trial_velocity(Xf, 1, Xi, dt, ·), returning the step's mean node
+  /// velocity U = J(Xi) (u^n + u^{n+1}) / 2. Here two interpolations; an operator may interpolate the mean field once
+  /// (J is linear in u).
+  virtual void trial_mean_velocity(std::span<const double> Xf, std::span<const double> Xi, double dt,
+                                   std::span<double> U) {
+    std::vector<double> Un(U.size());
+    trial_velocity(Xf, 1.0, Xi, dt, U);
+    committed_velocity(Xi, Un);
+    for (std::size_t i = 0; i < U.size(); ++i) U[i] = 0.5 * (Un[i] + U[i]);
+  }
   /// True when the last trial_velocity call completed with Xf = X exactly: its trial state is then the one the
   /// positions X drive, ready to be committed.
   virtual bool trial_matches(std::span<const double> X) const = 0;

@@ -7,13 +7,11 @@ StepStats MidpointRK2::step(CoupledOperator& op, double dt) {
   const auto Xn = op.positions();
   const auto Un = op.node_velocity();
   Xm_.resize(n);
-  U0_.resize(n);
-  U1_.resize(n);
+  Um_.resize(n);
   X_.resize(n);
   for (std::size_t i = 0; i < n; ++i) Xm_[i] = Xn[i] + 0.5 * dt * Un[i];
-  op.trial_velocity(Xm_, 1.0, Xm_, dt, U1_);
-  op.committed_velocity(Xm_, U0_);
-  for (std::size_t i = 0; i < n; ++i) X_[i] = Xn[i] + 0.5 * dt * (U0_[i] + U1_[i]);
+  op.trial_mean_velocity(Xm_, Xm_, dt, Um_);
+  for (std::size_t i = 0; i < n; ++i) X_[i] = Xn[i] + dt * Um_[i];
   remember(op, dt);
   op.commit(X_, dt);
   StepStats s;
