@@ -105,76 +105,84 @@ TEST(NavierStokesSolver, StepIsPureAndReusesTheOutputStorage) {
 }
 
 // prepare() then step() under several forces on the one prepared step, each bitwise the plain step(in, force, dt):
-// on the first step (forward Euler) and on a later one (Adams–Bashforth with r = 0.7), with moving walls, periodic
-// axes and a body force. Two code paths (the plain step builds the right-hand side in one pass): the prepared step
+// on the first step (forward Euler) and on later ones (Adams–Bashforth with r = 0.7 and r = 0.7/1.3), with moving
+// walls, periodic axes and a body force, with the lagged pressure of (9) and the extrapolated one (from the third
+// step on). Two code paths (the plain step builds the right-hand side in one pass): the prepared step
 // is only read and shares nothing with the plain steps taken in between. It refers to the state it was made from:
 // a change of that state's step counter or time is detected, and that state cannot be the output.
 TEST(NavierStokesSolver, PreparedStepUnderSeveralForcesEqualsThePlainStepBitwise) {
-  for (const auto bc : {std::array<Boundary, 3>{W, P, W}, {P, W, P}}) {
-    const Grid g({8, 6, 5}, {1, 0.75, 0.625}, bc);
-    FluidParams prm;
-    prm.mu = 0.1;
-    prm.body_force = {0.5, -1, 0.25};
-    for (int a = 0; a < 3; ++a)
-      if (bc[a] == W) {
-        prm.wall_lower[a] = {0.1, -0.2, 0.3};
-        prm.wall_upper[a] = {-0.3, 0.4, 0.2};
-        prm.wall_lower[a][a] = prm.wall_upper[a][a] = 0;
+  for (const auto pressure : {PressurePredictor::Lagged, PressurePredictor::Extrapolated}) {
+    for (const auto bc : {std::array<Boundary, 3>{W, P, W}, {P, W, P}}) {
+      const Grid g({8, 6, 5}, {1, 0.75, 0.625}, bc);
+      FluidParams prm;
+      prm.pressure = pressure;
+      prm.mu = 0.1;
+      prm.body_force = {0.5, -1, 0.25};
+      for (int a = 0; a < 3; ++a)
+        if (bc[a] == W) {
+          prm.wall_lower[a] = {0.1, -0.2, 0.3};
+          prm.wall_upper[a] = {-0.3, 0.4, 0.2};
+          prm.wall_lower[a][a] = prm.wall_upper[a][a] = 0;
+        }
+      NavierStokesSolver ns(g, prm, FftPlanning::Estimate);
+      std::mt19937 rng(11);
+      std::array<FaceField, 3> forces;
+      for (auto& f : forces) {
+        f = FaceField(g);
+        for (int d = 0; d < 3; ++d) randomize(f[d], rng);
       }
-    NavierStokesSolver ns(g, prm, FftPlanning::Estimate);
-    std::mt19937 rng(11);
-    std::array<FaceField, 3> forces;
-    for (auto& f : forces) {
-      f = FaceField(g);
-      for (int d = 0; d < 3; ++d) randomize(f[d], rng);
-    }
-    const FluidState first = random_state(ns, rng);
-    FluidState later;
-    ns.step(first, forces[0], 0.01, later);
-    ASSERT_EQ(later.step, 1);
-    ASSERT_GT(later.dt_prev, 0.0);
-    const FluidState other = random_state(ns, rng);
-    for (const FluidState* in : std::array<const FluidState*, 2>{&first, &later}) {
-      const double dt = 0.007;
+      const FluidState first = random_state(ns, rng);
+      FluidState later, latest;
+      ns.step(first, forces[0], 0.01, later);
+      ASSERT_EQ(later.step, 1);
+      ASSERT_GT(later.dt_prev, 0.0);
+      ns.step(later, forces[1], 0.013, latest);
+      ASSERT_GT(latest.dt_prev2, 0.0);
+      const FluidState other = random_state(ns, rng);
+      for (const FluidState* in : std::array<const FluidState*, 3>{&first, &later, &latest}) {
+        const double dt = 0.007;
+        PreparedStep prepared;
+        EXPECT_FALSE(prepared.prepared_for(*in, dt));
+        ns.prepare(*in, dt, prepared);
+        EXPECT_TRUE(prepared.prepared_for(*in, dt));
+        EXPECT_FALSE(prepared.prepared_for(*in, 0.5 * dt));
+        EXPECT_FALSE(prepared.prepared_for(in == &first ? later : first, dt));
+        EXPECT_FALSE(prepared.prepared_for(FluidState(*in), dt));  // (another object)
+        FluidState out, plain, scratch;
+        std::vector<double> u_first;
+        for (const auto& f : forces) {
+          ns.step(prepared, f, out);
+          ns.step(other, f, 0.02, scratch);
+          ns.step(*in, f, dt, plain);
+          EXPECT_TRUE(same(out.u, plain.u) && same(out.p, plain.p) && same(out.adv, plain.adv));
+          EXPECT_TRUE(same(out.p_prev, in->p));
+          EXPECT_EQ(out.step, plain.step);
+          EXPECT_EQ(out.time, plain.time);
+          EXPECT_EQ(out.dt_prev, plain.dt_prev);
+          EXPECT_EQ(out.dt_prev2, in->dt_prev);
+          if (u_first.empty())
+            u_first = out.u[0].values();
+          else
+            EXPECT_NE(out.u[0].values(), u_first);  // the forces do drive the flow
+        }
+      }
+      FluidState out;
+      EXPECT_THROW(ns.step(PreparedStep{}, forces[0], out), std::invalid_argument);
+      FluidState source = later;
       PreparedStep prepared;
-      EXPECT_FALSE(prepared.prepared_for(*in, dt));
-      ns.prepare(*in, dt, prepared);
-      EXPECT_TRUE(prepared.prepared_for(*in, dt));
-      EXPECT_FALSE(prepared.prepared_for(*in, 0.5 * dt));
-      EXPECT_FALSE(prepared.prepared_for(in == &first ? later : first, dt));
-      EXPECT_FALSE(prepared.prepared_for(FluidState(*in), dt));  // (another object)
-      FluidState out, plain, scratch;
-      std::vector<double> u_first;
-      for (const auto& f : forces) {
-        ns.step(prepared, f, out);
-        ns.step(other, f, 0.02, scratch);
-        ns.step(*in, f, dt, plain);
-        EXPECT_TRUE(same(out.u, plain.u) && same(out.p, plain.p) && same(out.adv, plain.adv));
-        EXPECT_EQ(out.step, plain.step);
-        EXPECT_EQ(out.time, plain.time);
-        EXPECT_EQ(out.dt_prev, plain.dt_prev);
-        if (u_first.empty())
-          u_first = out.u[0].values();
-        else
-          EXPECT_NE(out.u[0].values(), u_first);  // the forces do drive the flow
-      }
+      ns.prepare(source, 0.007, prepared);
+      EXPECT_THROW(ns.step(prepared, forces[0], source), std::invalid_argument);
+      ++source.step;
+      EXPECT_THROW(ns.step(prepared, forces[0], out), std::logic_error);
+      --source.step;
+      source.time += 0.007;
+      EXPECT_THROW(ns.step(prepared, forces[0], out), std::logic_error);
+      source.time = later.time;
+      ns.step(prepared, forces[1], out);
+      FluidState plain;
+      ns.step(later, forces[1], 0.007, plain);
+      EXPECT_TRUE(same(out.u, plain.u) && same(out.p, plain.p) && same(out.adv, plain.adv));
     }
-    FluidState out;
-    EXPECT_THROW(ns.step(PreparedStep{}, forces[0], out), std::invalid_argument);
-    FluidState source = later;
-    PreparedStep prepared;
-    ns.prepare(source, 0.007, prepared);
-    EXPECT_THROW(ns.step(prepared, forces[0], source), std::invalid_argument);
-    ++source.step;
-    EXPECT_THROW(ns.step(prepared, forces[0], out), std::logic_error);
-    --source.step;
-    source.time += 0.007;
-    EXPECT_THROW(ns.step(prepared, forces[0], out), std::logic_error);
-    source.time = later.time;
-    ns.step(prepared, forces[1], out);
-    FluidState plain;
-    ns.step(later, forces[1], 0.007, plain);
-    EXPECT_TRUE(same(out.u, plain.u) && same(out.p, plain.p) && same(out.adv, plain.adv));
   }
 }
 
@@ -483,31 +491,76 @@ TEST(NavierStokesSolver, UniformFlowThroughWallsWithEqualNormalVelocityIsSteady)
 // (10) with a variable step: AB2 weights (1 + r/2, −r/2). Steps alternating Δt and Δt/2 stay second order
 // (the constant weights 3/2, −1/2 would make the scheme first order). The reference is the same grid with a
 // tiny constant step, so the spatial error cancels.
+// The extrapolated pressure p^{n−1/2} + w (p^{n−1/2} − p^{n−3/2}) is exact for a pressure linear in time, at the
+// t^{n+1/2} of any step after any two steps (each pressure half its step behind the velocity); w = 1 for a constant
+// step and 0 before two steps are taken.
+TEST(NavierStokesSolver, ExtrapolatedPressureIsExactForAPressureLinearInTime) {
+  const auto p = [](double t) { return 2.0 - 3.0 * t; };
+  for (const std::array<double, 3> steps :
+       {std::array<double, 3>{0.1, 0.1, 0.1}, {0.05, 0.1, 0.3}, {0.2, 0.07, 0.01}}) {
+    const auto [dt2, dt1, dt] = steps;  // the steps that produced p^{n−3/2} and p^{n−1/2}, and the next one
+    const double tn = 1.0, p1 = p(tn - 0.5 * dt1), p0 = p(tn - dt1 - 0.5 * dt2);
+    EXPECT_NEAR(p1 + extrapolation_weight(dt, dt1, dt2) * (p1 - p0), p(tn + 0.5 * dt), 1e-14);
+  }
+  EXPECT_EQ(extrapolation_weight(0.1, 0.1, 0.1), 1.0);
+  EXPECT_EQ(extrapolation_weight(0.1, 0.1, 0.0), 0.0);
+}
+
+// A step from a state whose pressures differ takes p̃ when extrapolating: the result differs from the lagged one,
+// and equals the lagged step from the state whose p^{n−1/2} is p̃ (its (13) continues from p̃ as well).
+TEST(NavierStokesSolver, ExtrapolatedStepIsTheLaggedStepFromTheExtrapolatedPressure) {
+  const Grid g({8, 6, 5}, {1, 0.75, 0.625}, {W, P, W});
+  FluidParams lag, ext;
+  lag.mu = ext.mu = 0.1;
+  ext.pressure = PressurePredictor::Extrapolated;
+  NavierStokesSolver nl(g, lag, FftPlanning::Estimate), ne(g, ext, FftPlanning::Estimate);
+  std::mt19937 rng(5);
+  FluidState in = random_state(nl, rng);
+  randomize(in.p_prev, rng);
+  in.step = 2;
+  in.dt_prev = 0.01;
+  in.dt_prev2 = 0.02;
+  FaceField force(g);
+  for (int d = 0; d < 3; ++d) randomize(force[d], rng);
+  FluidState shifted = in, a, b, c;
+  const double dt = 0.015, w = extrapolation_weight(dt, in.dt_prev, in.dt_prev2);
+  for (std::size_t i = 0; i < in.p.size(); ++i) shifted.p[i] = in.p[i] + w * (in.p[i] - in.p_prev[i]);
+  ne.step(in, force, dt, a);
+  nl.step(shifted, force, dt, b);
+  nl.step(in, force, dt, c);
+  EXPECT_TRUE(same(a.u, b.u) && same(a.p, b.p));
+  EXPECT_FALSE(same(a.u, c.u));
+  EXPECT_TRUE(same(a.p_prev, in.p));
+}
+
 TEST(NavierStokesSolver, VariableStepAdamsBashforthStaysSecondOrder) {
   const TaylorGreen tg{2 * pi, 1.0, 0.01};
   const Grid g({24, 24, 2}, {1, 1, 2.0 / 24}, {P, P, P});
-  FluidParams prm;
-  prm.mu = tg.mu;
-  NavierStokesSolver ns(g, prm, FftPlanning::Estimate);
-  const double T = 0.3;
-  const auto run = [&](const std::vector<double>& pattern, int repeats) {
-    FluidState a = ns.initial_state(), b;
-    sample_velocity(
-        g, [&](const Vec3& x) { return tg.velocity(x, 0); }, a.u);
-    sample_pressure(
-        g, [&](const Vec3& x) { return tg.pressure(x, -0.5 * pattern[0]); }, a.p);
-    for (int r = 0; r < repeats; ++r)
-      for (double dt : pattern) {
-        ns.step(a, FaceField(g), dt, b);
-        std::swap(a, b);
-      }
-    return a;
-  };
-  const FluidState ref = run({T / 1200}, 1200);
-  std::vector<double> errors;
-  for (int m : {10, 20, 40}) {
-    const double dt = T / (1.5 * m);
-    errors.push_back(velocity_difference(g, run({dt, 0.5 * dt}, m).u, ref.u).max);
+  for (const auto pressure : {PressurePredictor::Lagged, PressurePredictor::Extrapolated}) {
+    FluidParams prm;
+    prm.mu = tg.mu;
+    prm.pressure = pressure;
+    NavierStokesSolver ns(g, prm, FftPlanning::Estimate);
+    const double T = 0.3;
+    const auto run = [&](const std::vector<double>& pattern, int repeats) {
+      FluidState a = ns.initial_state(), b;
+      sample_velocity(
+          g, [&](const Vec3& x) { return tg.velocity(x, 0); }, a.u);
+      sample_pressure(
+          g, [&](const Vec3& x) { return tg.pressure(x, -0.5 * pattern[0]); }, a.p);
+      for (int r = 0; r < repeats; ++r)
+        for (double dt : pattern) {
+          ns.step(a, FaceField(g), dt, b);
+          std::swap(a, b);
+        }
+      return a;
+    };
+    const FluidState ref = run({T / 1200}, 1200);
+    std::vector<double> errors;
+    for (int m : {10, 20, 40}) {
+      const double dt = T / (1.5 * m);
+      errors.push_back(velocity_difference(g, run({dt, 0.5 * dt}, m).u, ref.u).max);
+    }
+    EXPECT_GE(verify::min_observed_order(errors), 1.9);
   }
-  EXPECT_GE(verify::min_observed_order(errors), 1.9);
 }

@@ -1,8 +1,9 @@
 // A run is reproducible bit for bit in separate processes: with one and with two threads, and when continued from
-// a checkpoint by a new process. The grid (44^3 cells) is above MacGeom::kMinCellsForThreads, so the fluid
-// solvers' loops and FFTW's transforms run threaded with two threads. This holds with fluid.fft_planning =
-// "estimate" (the default), whose FFTW plans do not depend on timings; with "measure" the plans, and so the
-// round-off, may change from one process to the next (docs/performance.md, "Reproducibility").
+// a checkpoint by a new process (with either pressure of (9)). The grid (44^3 cells) is above
+// MacGeom::kMinCellsForThreads, so the fluid solvers' loops and FFTW's transforms run threaded with two threads.
+// This holds with fluid.fft_planning = "estimate" (the default), whose FFTW plans do not depend on timings; with
+// "measure" the plans, and so the round-off, may change from one process to the next (docs/performance.md,
+// "Reproducibility").
 #include <gtest/gtest.h>
 
 #include "immerse/io/Checkpoint.hpp"
@@ -21,9 +22,11 @@ std::vector<std::string> threaded_sets(int steps) {
   return s;
 }
 
-int run(const fs::path& out, int steps, int threads, const fs::path& restart = {}, const std::string& scheme = "jfnk") {
+int run(const fs::path& out, int steps, int threads, const fs::path& restart = {}, const std::string& scheme = "jfnk",
+        const std::string& pressure = "lagged") {
   auto sets = threaded_sets(steps);
   sets.push_back("time.scheme=" + scheme);
+  sets.push_back("fluid.pressure=" + pressure);
   const auto args = run_args(scenario_file("oscillating_membrane_quick.toml"), out, sets, restart);
   const auto r = run_immerse(args, out.string() + "_log", {"OMP_NUM_THREADS=" + std::to_string(threads)});
   EXPECT_EQ(r.err, "");
@@ -49,11 +52,15 @@ TEST_P(ThreadCount, RunsWithOneAndTwoThreadsInSeparateProcessesAreBitwiseIdentic
 INSTANTIATE_TEST_SUITE_P(Reproducibility, ThreadCount, ::testing::Values("jfnk", "anderson"),
                          [](const auto& p) { return p.param; });
 
-TEST(Reproducibility, RestartInANewProcessContinuesBitwise) {
+// For each pressure of (9): the extrapolated one needs the checkpoint's p^{n-3/2} at the restart (after two steps).
+class Restart : public ::testing::TestWithParam<std::string> {};
+
+TEST_P(Restart, InANewProcessContinuesBitwise) {
   ScratchDir dir("reproducible");
-  ASSERT_EQ(run(dir / "whole", kSteps, 2), 0);
-  ASSERT_EQ(run(dir / "split", kSteps / 2, 2), 0);
-  ASSERT_EQ(run(dir / "split", kSteps, 2, dir / "split" / "checkpoint.h5"), 0);
+  const std::string pressure = GetParam();
+  ASSERT_EQ(run(dir / "whole", kSteps, 2, {}, "jfnk", pressure), 0);
+  ASSERT_EQ(run(dir / "split", kSteps / 2, 2, {}, "jfnk", pressure), 0);
+  ASSERT_EQ(run(dir / "split", kSteps, 2, dir / "split" / "checkpoint.h5", "jfnk", pressure), 0);
   const auto whole = io::Checkpoint::read(dir / "whole" / "checkpoint.h5");
   const auto split = io::Checkpoint::read(dir / "split" / "checkpoint.h5");
   EXPECT_EQ(split.get_int("step"), kSteps);
@@ -61,5 +68,8 @@ TEST(Reproducibility, RestartInANewProcessContinuesBitwise) {
   EXPECT_EQ(without_wall_clock(read_csv(dir / "whole" / "diagnostics.csv")),
             without_wall_clock(read_csv(dir / "split" / "diagnostics.csv")));
 }
+
+INSTANTIATE_TEST_SUITE_P(Reproducibility, Restart, ::testing::Values("lagged", "extrapolated"),
+                         [](const auto& p) { return p.param; });
 
 }  // namespace

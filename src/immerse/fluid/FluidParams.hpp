@@ -4,6 +4,7 @@
 // f_body is a uniform body force (a mean pressure gradient) that drives periodic channel/duct flow.
 // On a wall axis a, the wall at the lower end moves with wall_lower[a] and the one at the upper end
 // with wall_upper[a] (constant in time); entries for periodic axes are ignored.
+// Also the one numerical choice of the step (NavierStokesSolver.hpp): the pressure that (9) takes.
 #include <array>
 
 #include "immerse/core/Vec3.hpp"
@@ -11,12 +12,17 @@
 
 namespace immerse {
 
+/// The pressure in the momentum step (9): p^{n−1/2} as printed (Lagged), or extrapolated to t^{n+1/2} from p^{n−1/2}
+/// and p^{n−3/2} (Extrapolated; second order in time also where the fluid is a Stokes flow at the step's scale).
+enum class PressurePredictor { Lagged, Extrapolated };
+
 struct FluidParams {
   double rho = 1.0;
   double mu = 1.0;
   Vec3 body_force{};
   std::array<Vec3, 3> wall_lower{};
   std::array<Vec3, 3> wall_upper{};
+  PressurePredictor pressure = PressurePredictor::Lagged;
 
   /// Throws a one-line InputError unless rho, mu > 0 and finite, the body force and wall velocities are finite,
   /// and on every wall axis the normal wall velocity is the same at both walls (zero net flux through the

@@ -69,12 +69,12 @@ inline double result_face(const RhsCoefficients& c, double un, double e, const d
 /// (u·∇_h u)^n (into adv) and the explicit terms of (9), or WithForce the right-hand side under `force` (into res),
 /// along row (j, k) of component D, i in [i0, i1) (no wall layer), reading through accessor R.
 template <int D, bool First, bool WithForce, class R>
-__attribute__((flatten)) void explicit_row(const MacGeom& g, const FluidState& in, const Array3* force,
-                                          const RhsCoefficients& c, Array3& adv, Array3& res, int j, int k, int i0,
-                                          int i1) {
+__attribute__((flatten)) void explicit_row(const MacGeom& g, const FluidState& in, const Array3& p,
+                                          const Array3* force, const RhsCoefficients& c, Array3& adv, Array3& res,
+                                          int j, int k, int i0, int i1) {
   // Everything the loop reads in locals: the compiler then sees loop-invariant rows and vectorizes. Flattened: with
   // the many instances of this kernel GCC would leave the stencil functions out of line, and the loop scalar.
-  const R ru(in.u[D], g, j, k), r0(in.u[0], g, j, k), r1(in.u[1], g, j, k), r2(in.u[2], g, j, k), rp(in.p, g, j, k);
+  const R ru(in.u[D], g, j, k), r0(in.u[0], g, j, k), r1(in.u[1], g, j, k), r2(in.u[2], g, j, k), rp(p, g, j, k);
   const std::size_t o = adv.index(0, j, k);
   const double* const fr = WithForce ? force->data() + o : nullptr;
   const double* const old = First ? nullptr : in.adv[D].data() + o;  // (not read on the first step)
@@ -94,11 +94,12 @@ __attribute__((flatten)) void explicit_row(const MacGeom& g, const FluidState& i
 }
 
 /// Writes (u·∇_h u)^n into adv and the explicit terms of (9), or WithForce the right-hand side under `force`, into
-/// res at every unknown of component D: the row kernels wherever they apply, the generic kernels in the wall layers.
+/// res at every unknown of component D (p: the pressure of (9)): the row kernels wherever they apply, the generic
+/// kernels in the wall layers.
 template <int D, bool First, bool WithForce>
-void build_t(const MacGeom& g, const FluidState& in, const Array3* force, const RhsCoefficients& c, Array3& adv,
-             Array3& res) {
-  const Array3 &un = in.u[D], &p = in.p;
+void build_t(const MacGeom& g, const FluidState& in, const Array3& p, const Array3* force, const RhsCoefficients& c,
+             Array3& adv, Array3& res) {
+  const Array3& un = in.u[D];
   const double* const f = WithForce ? force->data() : nullptr;
   for_each_split(
       g, face_box(g, D), interior_face_box(g, D),
@@ -114,22 +115,22 @@ void build_t(const MacGeom& g, const FluidState& in, const Array3* force, const 
       },
       [&](int j, int k, int i0, int i1) {
         if (mac::row_wraps(g, j, k))
-          explicit_row<D, First, WithForce, mac::WrappedRows>(g, in, force, c, adv, res, j, k, i0, i1);
+          explicit_row<D, First, WithForce, mac::WrappedRows>(g, in, p, force, c, adv, res, j, k, i0, i1);
         else
-          explicit_row<D, First, WithForce, mac::Strided>(g, in, force, c, adv, res, j, k, i0, i1);
+          explicit_row<D, First, WithForce, mac::Strided>(g, in, p, force, c, adv, res, j, k, i0, i1);
       });
 }
 
 /// build_t for component d (force: its component d, WithForce).
 template <bool WithForce>
-void build(const MacGeom& g, int d, const FluidState& in, const Array3* force, const RhsCoefficients& c, Array3& adv,
-           Array3& res) {
+void build(const MacGeom& g, int d, const FluidState& in, const Array3& p, const Array3* force,
+           const RhsCoefficients& c, Array3& adv, Array3& res) {
   const bool first = first_step(in);
   const auto run = [&]<int D>() {
     if (first)
-      build_t<D, true, WithForce>(g, in, force, c, adv, res);
+      build_t<D, true, WithForce>(g, in, p, force, c, adv, res);
     else
-      build_t<D, false, WithForce>(g, in, force, c, adv, res);
+      build_t<D, false, WithForce>(g, in, p, force, c, adv, res);
   };
   if (d == 0)
     run.template operator()<0>();
@@ -190,10 +191,11 @@ void project_row(const MacGeom& g, const Array3& us, const Array3& phi, Array3& 
 
 /// (12) and (13) along row (j, k) of the cells in one pass (φ read once for the three components): the unknowns of
 /// each component in that row (face_box: a component normal to a wall has none in the wall's first row), then
-/// p^{n+1/2} = p^{n−1/2} + φ − (μ/2) D u* at the cells.
+/// p^{n+1/2} = p0 + φ − (μ/2) D u* at the cells (p0: the pressure (9) took), keeping p^{n−1/2} (pn) as out.p_prev.
 template <class R>
 void project_and_update_row(const MacGeom& g, const FaceField& us, const Array3& phi, const Array3& div,
-                            const Array3& p0, FluidState& out, int j, int k, double dt_rho, double half_mu) {
+                            const Array3& p0, const Array3& pn, FluidState& out, int j, int k, double dt_rho,
+                            double half_mu) {
   const int i1 = g.n[0];
   project_row<0, R>(g, us[0], phi, out.u[0], j, k, g.first(0, 0), i1, dt_rho);
   if (j >= g.first(1, 1)) project_row<1, R>(g, us[1], phi, out.u[1], j, k, g.first(1, 0), i1, dt_rho);
@@ -202,12 +204,21 @@ void project_and_update_row(const MacGeom& g, const FaceField& us, const Array3&
   const double* const pr0 = p0.data() + o;
   const double* const ph = phi.data() + o;
   const double* const dv = div.data() + o;
+  const double* const prn = pn.data() + o;
   double* const pr1 = out.p.data() + o;
+  double* const prp = out.p_prev.data() + o;
 #pragma omp simd
-  for (int i = 0; i < i1; ++i) pr1[i] = pr0[i] + ph[i] - half_mu * dv[i];
+  for (int i = 0; i < i1; ++i) {
+    pr1[i] = pr0[i] + ph[i] - half_mu * dv[i];
+    prp[i] = prn[i];
+  }
 }
 
 }  // namespace
+
+double extrapolation_weight(double dt, double dt_prev, double dt_prev2) {
+  return dt_prev2 > 0 ? (dt + dt_prev) / (dt_prev + dt_prev2) : 0.0;
+}
 
 NavierStokesSolver::NavierStokesSolver(const Grid& grid, const FluidParams& params, FftPlanning planning)
     : grid_(grid),
@@ -226,6 +237,7 @@ FluidState NavierStokesSolver::initial_state() const {
   s.u = FaceField(grid_);
   s.adv = FaceField(grid_);
   s.p = Array3(grid_.n(0), grid_.n(1), grid_.n(2));
+  s.p_prev = Array3(grid_.n(0), grid_.n(1), grid_.n(2));
   apply_wall_values(s.u);
   return s;
 }
@@ -261,11 +273,28 @@ void NavierStokesSolver::check_force(const FaceField& force) const {
   if (!matches_grid(force)) throw std::invalid_argument("NavierStokesSolver::step: force does not match the grid");
 }
 
+const Array3& NavierStokesSolver::momentum_pressure(const FluidState& in, double dt, Array3& scratch) const {
+  if (params_.pressure == PressurePredictor::Lagged) return in.p;
+  const double w = extrapolation_weight(dt, in.dt_prev, in.dt_prev2);
+  if (w == 0.0) return in.p;
+  if (in.p_prev.shape() != grid_.cell_shape())
+    throw std::invalid_argument("NavierStokesSolver: state has no previous pressure to extrapolate from");
+  ensure_shape(scratch, grid_);
+  const long n = static_cast<long>(in.p.size());
+  const double* const p = in.p.data();
+  const double* const q = in.p_prev.data();
+  double* const s = scratch.data();
+#pragma omp parallel for schedule(static)
+  for (long i = 0; i < n; ++i) s[i] = p[i] + w * (p[i] - q[i]);
+  return scratch;
+}
+
 template <class Rhs>
-void NavierStokesSolver::advance(const FluidState& in, double dt, FluidState& out, Rhs&& rhs) {
+void NavierStokesSolver::advance(const FluidState& in, double dt, const Array3& p, FluidState& out, Rhs&& rhs) {
   ensure_shape(out.u, grid_);
   ensure_shape(out.adv, grid_);
   ensure_shape(out.p, grid_);
+  ensure_shape(out.p_prev, grid_);
 
   const MacGeom& g = geom_;
   const double rho = params_.rho, mu = params_.mu;
@@ -292,12 +321,13 @@ void NavierStokesSolver::advance(const FluidState& in, double dt, FluidState& ou
   const double half_mu = 0.5 * mu;
   for_each_row(g, IndexBox{{0, 0, 0}, g.n}, [&](int j, int k, int, int) {
     if (mac::row_wraps(g, j, k))
-      project_and_update_row<mac::WrappedRows>(g, ustar_, phi_, div_, in.p, out, j, k, dt_rho, half_mu);
+      project_and_update_row<mac::WrappedRows>(g, ustar_, phi_, div_, p, in.p, out, j, k, dt_rho, half_mu);
     else
-      project_and_update_row<mac::Strided>(g, ustar_, phi_, div_, in.p, out, j, k, dt_rho, half_mu);
+      project_and_update_row<mac::Strided>(g, ustar_, phi_, div_, p, in.p, out, j, k, dt_rho, half_mu);
   });
   apply_wall_values(out.u);
 
+  out.dt_prev2 = in.dt_prev;
   out.dt_prev = dt;
   out.step = in.step + 1;
   out.time = in.time + dt;
@@ -308,9 +338,10 @@ void NavierStokesSolver::step(const FluidState& in, const FaceField& force, doub
   check_force(force);
   if (&in == &out) throw std::invalid_argument("NavierStokesSolver::step: `in` and `out` must be different states");
   out.adv_of = 0;
+  const Array3& p = momentum_pressure(in, dt, ptilde_);
   // (9) in one pass: (u·∇_h u)^n into the new state, the right-hand side into u*.
-  advance(in, dt, out, [&](int d) {
-    build<true>(geom_, d, in, &force[d], rhs_coefficients(params_, in, dt, d), out.adv[d], ustar_[d]);
+  advance(in, dt, p, out, [&](int d) {
+    build<true>(geom_, d, in, p, &force[d], rhs_coefficients(params_, in, dt, d), out.adv[d], ustar_[d]);
   });
 }
 
@@ -319,8 +350,10 @@ void NavierStokesSolver::prepare(const FluidState& in, double dt, PreparedStep& 
   prepared.state_ = nullptr;  // (not prepared until the end)
   ensure_shape(prepared.adv_, grid_);
   ensure_shape(prepared.explicit_, grid_);
+  const Array3& p = momentum_pressure(in, dt, prepared.pressure_);
+  prepared.extrapolated_ = &p != &in.p;
   for (int d = 0; d < 3; ++d)
-    build<false>(geom_, d, in, nullptr, rhs_coefficients(params_, in, dt, d), prepared.adv_[d],
+    build<false>(geom_, d, in, p, nullptr, rhs_coefficients(params_, in, dt, d), prepared.adv_[d],
                  prepared.explicit_[d]);
   static std::atomic<std::uint64_t> prepares{0};  // (ids only: results never depend on it)
   prepared.state_ = &in;
@@ -349,7 +382,7 @@ void NavierStokesSolver::step(const PreparedStep& prepared, const FaceField& for
                        i1);
     });
   };
-  advance(*in, dt, out, [&](int d) {
+  advance(*in, dt, prepared.extrapolated_ ? prepared.pressure_ : in->p, out, [&](int d) {
     if (copy_adv)
       rhs.template operator()<true>(d);
     else

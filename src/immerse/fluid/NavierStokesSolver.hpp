@@ -16,6 +16,14 @@
 // solved directly by FastSolver. Since G is applied only at interior faces and ∇_h² for φ is D G with G φ = 0 on
 // walls, D u^{n+1} = 0 to round-off.
 //
+// The pressure of (9) (FluidParams::pressure). As printed, p^{n−1/2}, half a step behind t^{n+1/2}: where the fluid
+// is a Stokes flow at the step's scale (ν Δt/h² ≫ 1, as in §4.4) the lag errs by O(Δt) wherever the pressure changes
+// at O(1) rates (across a moving membrane, at the walls), and the membrane positions converge at first order only
+// (docs/time-integration.md). Extrapolated, (9) and (13) take instead
+//   p̃ = p^{n−1/2} + w (p^{n−1/2} − p^{n−3/2}),   w = (Δt + Δt_prev) / (Δt_prev + Δt_prev2),
+// the line through p^{n−1/2} at t^n − Δt_prev/2 and p^{n−3/2} at t^{n−1} − Δt_prev2/2, taken to t^{n+1/2} (w = 1 for
+// a constant step; w = 0 until two steps are taken), and the positions converge at second order there too.
+//
 // step(in, F, Δt) builds the right-hand side of (9) in one pass over the faces. A step may also be split in two:
 // prepare() does the part that depends on the state and Δt alone, the explicit terms
 // E = −ρ A^{n+1/2} − G p^{n−1/2} + (μ/2) ∇_h² u^n of (9) and (10); step(prepared, F) adds the force,
@@ -52,11 +60,17 @@ class PreparedStep {
   const FluidState* state_ = nullptr;  ///< the state prepared from (null: not prepared)
   FaceField adv_;                      ///< (u·∇_h u)^n at the unknowns: the adv of the next state
   FaceField explicit_;  ///< E = −ρ A^{n+1/2} − G p^{n−1/2} + (μ/2) ∇_h² u^n (wall sources included) at the unknowns
+  Array3 pressure_;     ///< p̃ of (9) and (13), when extrapolated_
+  bool extrapolated_ = false;  ///< whether (9) takes pressure_ (FluidParams::pressure), else p^{n−1/2}
   double dt_ = 0;       ///< Δt
   long step_ = 0;       ///< step and time of the state when prepared
   double time_ = 0;
   std::uint64_t id_ = 0;  ///< unique in the process for each prepare() (FluidState::adv_of)
 };
+
+/// The weight w of the extrapolated pressure p̃ = p^{n−1/2} + w (p^{n−1/2} − p^{n−3/2}) for a step dt after steps
+/// dt_prev (which produced p^{n−1/2}) and dt_prev2 (which produced p^{n−3/2}); 0 when dt_prev2 = 0 (no p^{n−3/2}).
+double extrapolation_weight(double dt, double dt_prev, double dt_prev2);
 
 class NavierStokesSolver {
  public:
@@ -103,15 +117,18 @@ class NavierStokesSolver {
   bool matches_grid(const FaceField& f) const;
   void check(const FluidState& in, double dt) const;  // dt > 0 (InputError), `in` on the grid
   void check_force(const FaceField& force) const;
+  /// The pressure (9) takes after `in` for a step dt: in.p, or p̃ written into `scratch` (FluidParams::pressure).
+  const Array3& momentum_pressure(const FluidState& in, double dt, Array3& scratch) const;
   /// The step of size dt after `in` into `out`, rhs(d) writing the right-hand side of (9) for component d into u*
-  /// and (u·∇_h u)^n into out.adv[d]: the solves (9), (11) and (12)–(13).
+  /// and (u·∇_h u)^n into out.adv[d]: the solves (9), (11) and (12)–(13), the last from the pressure p that (9) took.
   template <class Rhs>
-  void advance(const FluidState& in, double dt, FluidState& out, Rhs&& rhs);
+  void advance(const FluidState& in, double dt, const Array3& p, FluidState& out, Rhs&& rhs);
 
   std::array<std::unique_ptr<FastSolver>, 4> solvers_;
   FaceField ustar_;  // u*, then u^{n+1}
   Array3 div_;       // D u*
   Array3 phi_;       // pressure increment φ^{n+1}
+  Array3 ptilde_;    // p̃ of the one-pass step, when extrapolated
 };
 
 }  // namespace immerse

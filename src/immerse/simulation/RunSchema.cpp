@@ -92,6 +92,10 @@ ConfigSchema run_schema() {
                "initial velocity: at rest, the linear (Couette) profile between the moving walls, or the steady "
                "flow driven by fluid.body_force between resting walls (the discrete Poiseuille solution)");
 
+  s.add_string("fluid.pressure", "lagged", {"lagged", "extrapolated"},
+               "pressure in the momentum step (9): lagged, p^{n-1/2} as printed (first order in time where the fluid "
+               "is a Stokes flow at the step's scale, nu dt / h^2 >> 1, as in the red-cell channel), or extrapolated "
+               "to t^{n+1/2} from the last two pressures (second order there too)");
   s.add_string("fluid.fft_planning", "estimate", {"estimate", "measure"},
                "FFTW plans of the fast solvers: estimate (the same plans in every run: results bitwise reproducible "
                "across runs, restarts and thread counts) or measure (FFTW times candidate plans: the fluid step "

@@ -37,6 +37,8 @@ FluidParams make_fluid(const io::Config& c) {
   p.rho = c.get<double>("fluid.rho");
   p.mu = c.get<double>("fluid.mu");
   p.body_force = c.get<Vec3>("fluid.body_force");
+  p.pressure = c.get<std::string>("fluid.pressure") == "extrapolated" ? PressurePredictor::Extrapolated
+                                                                        : PressurePredictor::Lagged;
   for (int d = 0; d < 3; ++d) {
     p.wall_lower[d] = c.get<Vec3>(std::string("boundary.") + kAxes[d] + "_lower_velocity");
     p.wall_upper[d] = c.get<Vec3>(std::string("boundary.") + kAxes[d] + "_upper_velocity");
@@ -300,7 +302,10 @@ io::Checkpoint Simulation::checkpoint() const {
     ck.put_array("fluid.adv" + std::to_string(d), f.adv[d].values(), shape);
   }
   ck.put_array("fluid.p", f.p.values(), {std::size_t(f.p.nz()), std::size_t(f.p.ny()), std::size_t(f.p.nx())});
+  ck.put_array("fluid.p_prev", f.p_prev.values(),
+               {std::size_t(f.p_prev.nz()), std::size_t(f.p_prev.ny()), std::size_t(f.p_prev.nx())});
   ck.put_double("fluid.dt_prev", f.dt_prev);
+  ck.put_double("fluid.dt_prev2", f.dt_prev2);
   ck.put_int("fluid.step", f.step);
   ck.put_double("fluid.time", f.time);
   for (std::size_t m = 0; m < num_membranes(); ++m) {
@@ -348,6 +353,11 @@ void Simulation::restore(const io::Checkpoint& ck) {
   }
   f.p.values() = ck.array("fluid.p");
   f.dt_prev = ck.get_double("fluid.dt_prev");
+  // Checkpoints written before fluid.pressure have no p^{n-3/2}: an extrapolating run then lags for one step.
+  if (ck.has("fluid.p_prev")) {
+    f.p_prev.values() = ck.array("fluid.p_prev");
+    f.dt_prev2 = ck.get_double("fluid.dt_prev2");
+  }
   f.step = ck.get_int("fluid.step");
   f.time = ck.get_double("fluid.time");
   std::vector<std::vector<Vec3>> X(num_membranes());
