@@ -36,6 +36,18 @@ void parallel_assign(std::span<const T> src, std::vector<T>& dst) {
   for (long i = 0; i < n; ++i) d[i] = s[i];
 }
 
+/// out = theta a + (1 - theta) b on every face (out sized on first use, on the grid g).
+void blend(const Grid& g, double theta, const FaceField& a, const FaceField& b, FaceField& out) {
+  if (out[0].size() == 0) out = FaceField(g);
+  for (int d = 0; d < 3; ++d) {
+    auto& o = out[d];
+    const auto& x = a[d];
+    const auto& y = b[d];
+#pragma omp parallel for
+    for (std::size_t i = 0; i < o.size(); ++i) o[i] = theta * x[i] + (1.0 - theta) * y[i];
+  }
+}
+
 }  // namespace
 
 ImmersedBoundaryOperator::ImmersedBoundaryOperator(NavierStokesSolver& fluid, IBCoupler& coupler,
@@ -113,16 +125,7 @@ void ImmersedBoundaryOperator::trial_step(std::span<const double> Xf, double the
   }
   membrane_force_density(nodes(Xf), force_);
   timed(timings_.fluid, [&] {
-    if (theta < 1.0) {
-      if (mixed_[0].size() == 0) mixed_ = FaceField(fluid_.grid());
-      for (int d = 0; d < 3; ++d) {
-        auto& a = mixed_[d];
-        const auto& b = force_[d];
-        const auto& c = force_start_[d];
-#pragma omp parallel for
-        for (std::size_t i = 0; i < a.size(); ++i) a[i] = theta * b[i] + (1.0 - theta) * c[i];
-      }
-    }
+    if (theta < 1.0) blend(fluid_.grid(), theta, force_, force_start_, mixed_);
     if (!prepared_.prepared_for(committed_, dt)) fluid_.prepare(committed_, dt, prepared_);
     fluid_.step(prepared_, theta < 1.0 ? mixed_ : force_, trial_);
   });
@@ -144,14 +147,7 @@ void ImmersedBoundaryOperator::trial_mean_velocity(std::span<const double> Xf, s
                                                    std::span<double> U) {
   trial_step(Xf, 1.0, dt);
   timed(timings_.interpolate, [&] {
-    if (mean_[0].size() == 0) mean_ = FaceField(fluid_.grid());
-    for (int d = 0; d < 3; ++d) {
-      auto& m = mean_[d];
-      const auto& a = committed_.u[d];
-      const auto& b = trial_.u[d];
-#pragma omp parallel for
-      for (std::size_t i = 0; i < m.size(); ++i) m[i] = 0.5 * (a[i] + b[i]);
-    }
+    blend(fluid_.grid(), 0.5, trial_.u, committed_.u, mean_);
     coupler_.interpolate_velocity(mean_, nodes(Xi), {reinterpret_cast<Vec3*>(U.data()), U.size() / 3});
   });
   parallel_assign(Xf, trial_X_);
