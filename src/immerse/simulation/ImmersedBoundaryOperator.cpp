@@ -97,18 +97,25 @@ void ImmersedBoundaryOperator::membrane_force_density(std::span<const Vec3> X, F
   const int M = static_cast<int>(membranes_.size());
   const bool across = M >= 2 * omp_get_max_threads();
   std::vector<std::exception_ptr> error(membranes_.size());
+  auto one = [&](int m) {
+    try {
+      nodal_force(static_cast<std::size_t>(m), X);
+    } catch (...) {
+      error[m] = std::current_exception();
+    }
+  };
+  // No enclosing region when the membranes go one at a time: a region nested in an inactive one gets freshly
+  // created threads in libgomp at every call (tens of microseconds each, once per pass of every force).
   timed(timings_.force, [&] {
-#pragma omp parallel if (across)
-    {
-      if (across) omp_set_num_threads(1);  // for the regions nested in this thread's membranes
+    if (across) {
+#pragma omp parallel
+      {
+        omp_set_num_threads(1);  // for the regions nested in this thread's membranes
 #pragma omp for schedule(dynamic)
-      for (int m = 0; m < M; ++m) {
-        try {
-          nodal_force(static_cast<std::size_t>(m), X);
-        } catch (...) {
-          error[m] = std::current_exception();
-        }
+        for (int m = 0; m < M; ++m) one(m);
       }
+    } else {
+      for (int m = 0; m < M; ++m) one(m);
     }
   });
   for (const auto& e : error)
