@@ -1,5 +1,6 @@
 // immerse: implicit immersed-boundary simulation of elastic membranes in 3D incompressible flow.
 #include <CLI/CLI.hpp>
+#include <filesystem>
 #include <iostream>
 
 #include "immerse/core/Error.hpp"
@@ -22,6 +23,22 @@ int run_verify(const std::string& name, bool quick) {
     ok = run_study(find_study(name), quick, std::cout);
   }
   return ok ? 0 : 1;
+}
+
+}  // namespace
+
+namespace {
+
+/// The bundled scenarios: the installed copy next to an installed program (PREFIX/share/immerse/scenarios), else
+/// the source tree's.
+std::filesystem::path bundled_scenarios() {
+  std::error_code ec;
+  const auto exe = std::filesystem::read_symlink("/proc/self/exe", ec);
+  if (!ec) {
+    const auto installed = exe.parent_path() / IMMERSE_INSTALLED_SCENARIOS;
+    if (std::filesystem::is_directory(installed, ec)) return installed.lexically_normal();
+  }
+  return std::filesystem::path(IMMERSE_SOURCE_DIR) / "scenarios";
 }
 
 }  // namespace
@@ -60,7 +77,7 @@ int main(int argc, char** argv) {
   }
   try {
     if (*scenarios) {
-      immerse::list_scenarios(IMMERSE_SOURCE_DIR "/scenarios", std::cout);
+      immerse::list_scenarios(bundled_scenarios(), std::cout);
       return 0;
     }
     if (*run && help_config) {

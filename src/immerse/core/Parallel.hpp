@@ -1,7 +1,7 @@
 #pragma once
 // Work sizes below which a loop runs on one thread: starting a parallel region and waking its threads costs from
 // a few microseconds (threads spinning) to tens of microseconds (threads asleep, or inter-processor interrupts in a
-// virtual machine), more than such a loop's whole work. bench/threads.sh times the runs that depend on them
+// virtual machine), more than such a loop's whole work. bench/threads.py times the runs that depend on them
 // (docs/performance.md, "Threads").
 
 namespace immerse {

@@ -12,7 +12,7 @@
 //
 // The fixed policy (OMP_NUM_THREADS set, or a single available CPU) leaves OpenMP's thread count alone.
 //
-// Checked by tests/test_thread_governor.cpp and measured by bench/threads.sh (docs/performance.md, "Threads").
+// Checked by tests/test_thread_governor.cpp and measured by bench/threads.py (docs/performance.md, "Threads").
 #include <cstddef>
 #include <string>
 
