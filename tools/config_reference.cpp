@@ -24,7 +24,22 @@ std::string cell(std::string_view text) {
   return out;
 }
 
-std::string code(std::string_view text) { return "`" + std::string(text) + "`"; }
+// Plain text in a cell: '*' would start emphasis ("10*4^l").
+std::string text_cell(std::string_view text) {
+  std::string out;
+  for (const char c : text) {
+    if (c == '*') out += '\\';
+    out += c;
+  }
+  return cell(out);
+}
+
+std::string code(std::string_view text) {
+  std::string out(1, '`');
+  out.append(text);
+  out.push_back('`');
+  return out;
+}
 
 void table_head(std::ostream& os) {
   os << "| key | default | allowed | meaning |\n| --- | --- | --- | --- |\n";
@@ -32,7 +47,7 @@ void table_head(std::ostream& os) {
 
 void row(std::ostream& os, const immerse::io::KeySpec& k, const std::string& prefix) {
   os << "| " << cell(code(prefix + k.key)) << " | " << cell(code(immerse::io::format_toml(k.default_value))) << " | "
-     << cell(k.allowed()) << " | " << cell(k.doc) << " |\n";
+     << text_cell(k.allowed()) << " | " << text_cell(k.doc) << " |\n";
 }
 
 std::string table_of(const std::string& key) {
@@ -46,8 +61,8 @@ int main() {
   const immerse::io::ConfigSchema schema = immerse::run_schema();
   std::ostream& os = std::cout;
   os << "# Configuration reference\n\n"
-        "Every key of an `immerse run` configuration file, with its default, what is allowed and its meaning (SI "
-        "units unless the key says otherwise). This page is generated from the program's schema by\n"
+        "Every key of an `immerse run` configuration file, with its default, what is allowed and its meaning\n"
+        "(SI units unless the key says otherwise). This page is generated from the program's schema by\n"
         "`build/release/immerse-config-reference > docs/reference/configuration.md`; the test\n"
         "`docs.configuration_reference` fails when it differs from the program. The same list, as plain text, is\n"
         "printed by `immerse run FILE --help-config`. How the file is written, how `--set` works and what bad input\n"
@@ -63,9 +78,12 @@ int main() {
     row(os, k, "");
   }
   for (const auto& a : schema.table_arrays()) {
-    os << "\n## `[[" << a.name << "]]`\n\nA repeated table: " << a.doc << " (at least " << a.min_count
-       << (a.min_count == 1 ? " entry" : " entries") << "). Each entry takes these keys; on the command line entry i is `"
-       << a.name << "[i].KEY`.\n\n";
+    os << "\n## `[[" << a.name << "]]`\n\nA repeated table: " << a.doc << " (";
+    if (a.min_count == 0)
+      os << "any number of entries";
+    else
+      os << "at least " << a.min_count << (a.min_count == 1 ? " entry" : " entries");
+    os << "). Each entry takes these keys; on the command line entry i is `" << a.name << "[i].KEY`.\n\n";
     table_head(os);
     for (const auto& k : a.entry->keys()) row(os, k, "");
   }
