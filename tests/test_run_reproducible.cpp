@@ -6,6 +6,7 @@
 // "Reproducibility").
 #include <gtest/gtest.h>
 
+#include "immerse/core/ThreadGovernor.hpp"
 #include "immerse/io/Checkpoint.hpp"
 #include "test_run_support.hpp"
 
@@ -22,14 +23,22 @@ std::vector<std::string> threaded_sets(int steps) {
   return s;
 }
 
+std::string& last_stdout() {
+  static std::string out;
+  return out;
+}
+
 int run(const fs::path& out, int steps, int threads, const fs::path& restart = {}, const std::string& scheme = "jfnk",
         const std::string& pressure = "lagged") {
   auto sets = threaded_sets(steps);
   sets.push_back("time.scheme=" + scheme);
   sets.push_back("fluid.pressure=" + pressure);
   const auto args = run_args(scenario_file("oscillating_membrane_quick.toml"), out, sets, restart);
-  const auto r = run_immerse(args, out.string() + "_log", {"OMP_NUM_THREADS=" + std::to_string(threads)});
+  // threads = 0: OMP_NUM_THREADS unset (the count is then chosen by measurement).
+  const auto r = run_immerse(args, out.string() + "_log",
+                             {threads > 0 ? "OMP_NUM_THREADS=" + std::to_string(threads) : "OMP_NUM_THREADS"});
   EXPECT_EQ(r.err, "");
+  last_stdout() = r.out;
   return r.status;
 }
 
@@ -51,6 +60,30 @@ TEST_P(ThreadCount, RunsWithOneAndTwoThreadsInSeparateProcessesAreBitwiseIdentic
 
 INSTANTIATE_TEST_SUITE_P(Reproducibility, ThreadCount, ::testing::Values("jfnk", "anderson"),
                          [](const auto& p) { return p.param; });
+
+// Without OMP_NUM_THREADS the thread count is chosen by measurement: the first evaluations run on both threads, the
+// next on one, then on the cheaper, with probes of the other; the run is bitwise the one-thread run.
+TEST(Reproducibility, ThreadCountChosenByMeasurementGivesTheOneThreadRunBitwise) {
+  ScratchDir dir("reproducible");
+  ASSERT_EQ(run(dir / "one", kSteps, 1), 0);
+  ASSERT_EQ(run(dir / "chosen", kSteps, 0), 0);
+  const std::string out = last_stdout();
+  if (AvailableCpus::of_this_process().count() > 1) {
+    const auto at = out.find("chosen by measurement");
+    ASSERT_NE(at, std::string::npos) << out;
+    // "1 thread for X % of N evaluations, 2 for Y %": both counts were used.
+    const auto one = out.find("1 thread for ", at), two = out.find(" for ", out.find("evaluations, ", at));
+    ASSERT_NE(one, std::string::npos) << out;
+    ASSERT_NE(two, std::string::npos) << out;
+    EXPECT_GT(std::stod(out.substr(one + 13)), 0.0) << out;
+    EXPECT_GT(std::stod(out.substr(two + 5)), 0.0) << out;
+  }
+  const auto one = io::Checkpoint::read(dir / "one" / "checkpoint.h5");
+  const auto chosen = io::Checkpoint::read(dir / "chosen" / "checkpoint.h5");
+  EXPECT_TRUE(one == chosen) << "checksums " << one.checksum() << " vs " << chosen.checksum();
+  EXPECT_EQ(without_wall_clock(read_csv(dir / "one" / "diagnostics.csv")),
+            without_wall_clock(read_csv(dir / "chosen" / "diagnostics.csv")));
+}
 
 // For each pressure of (9): the extrapolated one needs the checkpoint's p^{n-3/2} at the restart (after two steps).
 class Restart : public ::testing::TestWithParam<std::string> {};

@@ -59,7 +59,7 @@ inline std::string read_text(const fs::path& path) {
 /// A started `immerse ARGS...` with its stdout and stderr going to files.
 class ImmerseProcess {
  public:
-  /// `env`: NAME=VALUE entries set for the child (replacing inherited ones of the same name).
+  /// `env`: NAME=VALUE entries set for the child (replacing inherited ones of the same name); a bare NAME removes it.
   ImmerseProcess(const std::vector<std::string>& args, const fs::path& log_prefix,
                  const std::vector<std::string>& env = {})
       : out_(log_prefix.string() + ".stdout"), err_(log_prefix.string() + ".stderr") {
@@ -73,8 +73,10 @@ class ImmerseProcess {
     std::vector<std::string> env_s;
     std::string asan = "ASAN_OPTIONS=detect_leaks=0";
     auto overridden = [&](const std::string& v) {
-      for (const auto& e : env)
-        if (v.rfind(e.substr(0, e.find('=') + 1), 0) == 0) return true;
+      for (const auto& e : env) {
+        const auto eq = e.find('=');
+        if (v.rfind(eq == std::string::npos ? e + "=" : e.substr(0, eq + 1), 0) == 0) return true;
+      }
       return false;
     };
     for (char** e = environ; *e; ++e) {
@@ -83,7 +85,8 @@ class ImmerseProcess {
       else if (!overridden(v)) env_s.push_back(v);
     }
     env_s.push_back(asan);
-    env_s.insert(env_s.end(), env.begin(), env.end());
+    for (const auto& e : env)
+      if (e.find('=') != std::string::npos) env_s.push_back(e);
     std::vector<char*> envp;
     for (auto& v : env_s) envp.push_back(v.data());
     envp.push_back(nullptr);

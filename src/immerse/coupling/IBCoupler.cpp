@@ -6,6 +6,7 @@
 #include <string>
 
 #include "immerse/coupling/NodeDiagnostics.hpp"
+#include "immerse/core/Parallel.hpp"
 
 namespace immerse {
 
@@ -160,7 +161,7 @@ void IBCoupler::sort_into_blocks(std::span<const Vec3> X) {
   block_of_node_.resize(X.size());
   block_nodes_.resize(X.size());
   std::fill(block_start_.begin(), block_start_.end(), 0);
-#pragma omp parallel for
+#pragma omp parallel for if (n >= kMinNodesForThreads)
   for (int l = 0; l < n; ++l) {
     int block[2];
     for (int b = 0; b < 2; ++b) {
@@ -186,7 +187,7 @@ void IBCoupler::spread(std::span<const Vec3> X, std::span<const Vec3> F, FaceFie
   for (int d = 0; d < 3; ++d) {
     double* p = f[d].data();
     const long size = static_cast<long>(f[d].size());
-#pragma omp parallel for
+#pragma omp parallel for if (size >= kMinCellsForThreads)
     for (long i = 0; i < size; ++i) p[i] = 0.0;
   }
   // Colours (y block parity, z block parity) one after another; blocks of one colour in
@@ -195,7 +196,7 @@ void IBCoupler::spread(std::span<const Vec3> X, std::span<const Vec3> F, FaceFie
   for (int colour = 0; colour < 4; ++colour) {
     const int cy = colour % 2, cz = colour / 2;
     const int my = (blocks_[0] - cy + 1) / 2, mz = (blocks_[1] - cz + 1) / 2;
-#pragma omp parallel for schedule(dynamic, 1)
+#pragma omp parallel for schedule(dynamic, 1) if (static_cast<long>(X.size()) >= kMinNodesForThreads)
     for (int m = 0; m < my * mz; ++m) {
       const int b = (cy + 2 * (m % my)) + blocks_[0] * (cz + 2 * (m / my));
       for (int p = block_start_[b]; p < block_start_[b + 1]; ++p) {
@@ -211,7 +212,7 @@ void IBCoupler::spread(std::span<const Vec3> X, std::span<const Vec3> F, FaceFie
 template <class K>
 void IBCoupler::interpolate(const FaceField& u, std::span<const Vec3> X, std::span<Vec3> U) const {
   const long n = static_cast<long>(X.size());
-#pragma omp parallel for
+#pragma omp parallel for if (n >= kMinNodesForThreads)
   for (long l = 0; l < n; ++l) {
     const NodeStencil<K> s(axes_, X[l]);
     for (int d = 0; d < 3; ++d) U[l][d] = interpolate_component(s.along(0, d), s.along(1, d), s.along(2, d), u[d]);

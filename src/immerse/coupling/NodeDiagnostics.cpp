@@ -5,6 +5,7 @@
 #include <sstream>
 
 #include "immerse/core/Error.hpp"
+#include "immerse/core/Parallel.hpp"
 
 namespace immerse {
 
@@ -36,7 +37,7 @@ void check_nodes_in_domain(const Grid& grid, std::span<const Vec3> X) {
     hi[a] = grid.periodic(a) ? INFINITY : grid.origin()[a] + grid.length(a);
   }
   long first_bad = n;
-#pragma omp parallel for reduction(min : first_bad)
+#pragma omp parallel for reduction(min : first_bad) if (n >= kMinNodesForThreads)
   for (long l = 0; l < n; ++l) {
     const Vec3& x = X[l];
     bool ok = isfinite(x);
@@ -59,7 +60,7 @@ double min_wall_distance(const Grid& grid, std::span<const Vec3> X) {
   for (int a = 0; a < 3; ++a) {
     if (grid.periodic(a)) continue;
     const double lo = grid.origin()[a], hi = lo + grid.length(a);
-#pragma omp parallel for reduction(min : d)
+#pragma omp parallel for reduction(min : d) if (n >= kMinNodesForThreads)
     for (long l = 0; l < n; ++l) d = std::fmin(d, std::fmin(X[l][a] - lo, hi - X[l][a]));
   }
   return d;

@@ -79,17 +79,25 @@ FastSolver::FastSolver(const Grid& grid, Layout layout, FftPlanning planning, Ar
   const int dims[3] = {m_[2], m_[1], m_[0]};
   const fftw_r2r_kind kf[3] = {fwd[2], fwd[1], fwd[0]}, kb[3] = {bwd[2], bwd[1], bwd[0]};
   const unsigned flags = planning == FftPlanning::Measure ? FFTW_MEASURE : FFTW_ESTIMATE;
-  fftw_plan_with_nthreads(threaded_ ? omp_get_max_threads() : 1);
-  forward_ = fftw_plan_r2r(3, dims, data_, data_, kf, flags);
-  backward_ = fftw_plan_r2r(3, dims, data_, data_, kb, flags);
-  if (forward_ == nullptr || backward_ == nullptr) throw std::runtime_error("FFTW could not plan a fast solver");
+  const int threads = threaded_ ? omp_get_max_threads() : 1;
+  for (int t = 0; t < (threads > 1 ? 2 : 1); ++t) {
+    fftw_plan_with_nthreads(t == 0 ? 1 : threads);
+    forward_[t] = fftw_plan_r2r(3, dims, data_, data_, kf, flags);
+    backward_[t] = fftw_plan_r2r(3, dims, data_, data_, kb, flags);
+    if (forward_[t] == nullptr || backward_[t] == nullptr)
+      throw std::runtime_error("FFTW could not plan a fast solver");
+  }
 }
 
 FastSolver::~FastSolver() {
-  fftw_destroy_plan(forward_);
-  fftw_destroy_plan(backward_);
+  for (int t = 0; t < 2; ++t) {
+    if (forward_[t]) fftw_destroy_plan(forward_[t]);
+    if (backward_[t]) fftw_destroy_plan(backward_[t]);
+  }
   if (buf_) fftw_free(buf_);
 }
+
+int FastSolver::plan_index() const { return forward_[1] != nullptr && omp_get_max_threads() > 1 ? 1 : 0; }
 
 void FastSolver::set_symbol(double alpha, double beta) {
   const int mx = m_[0], my = m_[1], mz = m_[2];
@@ -123,12 +131,13 @@ void FastSolver::solve(Array3& x, double alpha, double beta) {
         for (int i = 0; i < mx; ++i) b[i + mx * (j + my * static_cast<std::size_t>(k))] = x(i + ox, j + oy, k + oz);
   }
   if (!(alpha == alpha_ && beta == beta_)) set_symbol(alpha, beta);
-  fftw_execute(forward_);
+  const int t = plan_index();
+  fftw_execute(forward_[t]);
   const double* const inv = inverse_.data();
   const long total = static_cast<long>(inverse_.size());
 #pragma omp parallel for simd schedule(static) if (parallel : threaded_)
   for (long n = 0; n < total; ++n) b[n] *= inv[n];
-  fftw_execute(backward_);
+  fftw_execute(backward_[t]);
   if (target_) return;
 #pragma omp parallel for collapse(2) schedule(static) if (threaded_)
   for (int k = 0; k < mz; ++k)
@@ -137,8 +146,9 @@ void FastSolver::solve(Array3& x, double alpha, double beta) {
 }
 
 void FastSolver::transform_round_trip() {
-  fftw_execute(forward_);
-  fftw_execute(backward_);
+  const int t = plan_index();
+  fftw_execute(forward_[t]);
+  fftw_execute(backward_[t]);
 }
 
 }  // namespace immerse

@@ -13,8 +13,9 @@
 // denominator (the constant null mode of the periodic/Neumann Poisson problem) gives a zero coefficient. The
 // factors 1/(α + β Σλ) are tabulated for the last (α, β) (a time step changes them; the step after uses the table).
 //
-// One in-place 3D r2r plan pair per solver, created once (see FftPlanning) and executed with FFTW threads
-// (omp_get_max_threads() at construction; one thread below MacGeom::kMinCellsForThreads unknowns). The plans work
+// One in-place 3D r2r plan pair per solver, created once (see FftPlanning); at or above
+// MacGeom::kMinCellsForThreads unknowns a second pair for omp_get_max_threads() (at construction) FFTW threads,
+// executed whenever OpenMP's thread count is above one when solve() is called (ThreadGovernor may change it). The plans work
 // on an internal buffer (the unknowns copied in and out), or, for a solver made for one array whose unknowns are
 // the whole array (every layout but a face-normal component on a wall axis), on that array itself. Not reentrant.
 // A distributed (FFTW-MPI) backend can replace this class behind the same solve().
@@ -77,8 +78,10 @@ class FastSolver {
   double* buf_ = nullptr;      // the work buffer, or null when working in place
   Array3* target_ = nullptr;   // the array solved in place, if any
   double* data_ = nullptr;     // where the transforms run: buf_ or target_'s data
-  fftw_plan_s* forward_ = nullptr;
-  fftw_plan_s* backward_ = nullptr;
+  /// Which plan pair solve() runs: 0 the one-thread pair, 1 the threaded pair.
+  int plan_index() const;
+  fftw_plan_s* forward_[2] = {nullptr, nullptr};  // [0] one thread, [1] threaded (if planned)
+  fftw_plan_s* backward_[2] = {nullptr, nullptr};
 };
 
 }  // namespace immerse

@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <array>
 
+#include "immerse/core/Parallel.hpp"
 #include "immerse/core/Vec3.hpp"
 #include "immerse/fluid/FluidParams.hpp"
 #include "immerse/grid/Grid.hpp"
@@ -33,7 +34,7 @@ struct MacGeom {
   /// Whether loops over this grid are worth spreading over OpenMP threads (below ~40³ cells the fork/join
   /// costs more than the work).
   bool threaded() const { return static_cast<long>(n[0]) * n[1] * n[2] >= kMinCellsForThreads; }
-  static constexpr long kMinCellsForThreads = 65536;
+  static constexpr long kMinCellsForThreads = immerse::kMinCellsForThreads;
 
   /// First unknown index of velocity component d along axis a (the end is always n[a], exclusive).
   int first(int d, int a) const { return (a == d && !periodic[a]) ? 1 : 0; }

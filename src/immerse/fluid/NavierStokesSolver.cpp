@@ -284,7 +284,7 @@ const Array3& NavierStokesSolver::momentum_pressure(const FluidState& in, double
   const double* const p = in.p.data();
   const double* const q = in.p_prev.data();
   double* const s = scratch.data();
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) if (n >= MacGeom::kMinCellsForThreads)
   for (long i = 0; i < n; ++i) s[i] = p[i] + w * (p[i] - q[i]);
   return scratch;
 }

@@ -8,6 +8,7 @@
 #include "immerse/core/Cholesky_K.hpp"
 #include "immerse/core/Error.hpp"
 #include "immerse/membrane/BalancedRange.hpp"
+#include "immerse/core/Parallel.hpp"
 
 namespace immerse {
 
@@ -93,7 +94,7 @@ void CurvatureFit::compute(const std::vector<Vec3>& X, std::vector<Vec3>& normal
   const int N = static_cast<int>(start_.size()) - 1;
   normal.resize(N);
   kappa.resize(N);
-#pragma omp parallel
+#pragma omp parallel if (static_cast<long>(N) >= kMinElementsForThreads)
   for (auto [i, end] = balanced_node_range(start_); i < end; ++i) {
     Vec3 Xs, Xt, Xss, Xst, Xtt;
     for (int j = start_[i]; j < start_[i + 1]; ++j) {

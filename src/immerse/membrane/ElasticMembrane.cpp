@@ -11,6 +11,7 @@
 #include "immerse/membrane/BalancedRange.hpp"
 #include "immerse/membrane/MembraneKinematics_K.hpp"
 #include "immerse/membrane/QuadraticTriangle_K.hpp"
+#include "immerse/core/Parallel.hpp"
 
 namespace immerse {
 
@@ -208,6 +209,7 @@ ElasticMembrane::ElasticMembrane(const Mesh& mesh, std::vector<Vec3> reference, 
       store_metric(ref_quad_, 6 * e + k, membrane_k::ref_metric(tq));
     }
   }
+  threaded_ = static_cast<long>(E) >= kMinElementsForThreads;
   if (bending_.kappa_B > 0) fit_.emplace(mesh, reference_);
   kappa_ref_ = fit_ && bending_.reference == ReferenceCurvature::RestShape ? reference_mean_curvature()
                                                                           : std::vector<double>(N, 0.0);
@@ -231,7 +233,7 @@ void ElasticMembrane::node_pass(const std::vector<Vec3>& X, bool with_tension, W
   int bad = INT_MAX;
   std::visit(
       [&](const auto& W) {
-#pragma omp parallel for schedule(static) reduction(min : bad)
+#pragma omp parallel for schedule(static) reduction(min : bad) if (threaded_)
         for (int e = 0; e < E; ++e) {
           const Nodes x = element_nodes(elements_[e], X);
           const Vec3 chord = chord_normal(x);
@@ -259,7 +261,7 @@ void ElasticMembrane::node_pass(const std::vector<Vec3>& X, bool with_tension, W
   throw_if_bad(bad);
   w.node_n.resize(N);
   if (with_tension) w.node_tau.resize(N);
-#pragma omp parallel
+#pragma omp parallel if (threaded_)
   for (auto [i, end] = balanced_node_range(inc_start_); i < end; ++i) {
     Vec3 n;
     membrane_k::SymTensor tau;
@@ -281,7 +283,7 @@ void ElasticMembrane::moment_pass(const std::vector<Vec3>& X, Work& w) const {
   const int N = static_cast<int>(num_nodes());
   fit_->compute(X, w.node_nfit, w.node_kappa);
   w.node_m.resize(N);
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) if (threaded_)
   for (int i = 0; i < N; ++i)
     w.node_m[i] = bending_.kappa_B * (w.node_kappa[i] - kappa_ref_[i] * projector(w.node_nfit[i]));
 }
@@ -292,7 +294,7 @@ void ElasticMembrane::bending_passes(const std::vector<Vec3>& X, Work& w) const 
   const int N = static_cast<int>(num_nodes());
   moment_pass(X, w);
   w.node_q.resize(N);
-#pragma omp parallel
+#pragma omp parallel if (threaded_)
   for (auto [i, end] = balanced_node_range(inc_start_); i < end; ++i) {
     Vec3 div;
     for (int j = inc_start_[i]; j < inc_start_[i + 1]; ++j) {
@@ -316,7 +318,7 @@ void ElasticMembrane::contour_forces(const std::vector<Vec3>& X, bool with_tensi
   const int E = static_cast<int>(num_elements());
   w.el_force.resize(E);
   w.el_frac.resize(E);
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) if (threaded_)
   for (int e = 0; e < E; ++e) {
     const auto& el = elements_[e];
     const Nodes x = element_nodes(el, X);
@@ -353,7 +355,7 @@ void ElasticMembrane::energy_forces(const std::vector<Vec3>& X, Work& w) const {
   int bad = INT_MAX;
   std::visit(
       [&](const auto& W) {
-#pragma omp parallel for schedule(static) reduction(min : bad)
+#pragma omp parallel for schedule(static) reduction(min : bad) if (threaded_)
         for (int e = 0; e < E; ++e) {
           const Nodes x = element_nodes(elements_[e], X);
           const Vec3 chord = chord_normal(x);
@@ -393,7 +395,7 @@ void ElasticMembrane::compute_force(const std::vector<Vec3>& X, std::vector<Vec3
   // Node i collects its share of every element's force, slots in ascending element order.
   const int N = static_cast<int>(num_nodes());
   F.resize(N);
-#pragma omp parallel
+#pragma omp parallel if (threaded_)
   for (auto [i, end] = balanced_node_range(inc_start_); i < end; ++i) {
     Vec3 s;
     for (int j = inc_start_[i]; j < inc_start_[i + 1]; ++j) {
@@ -417,7 +419,7 @@ double ElasticMembrane::compute_energy(const std::vector<Vec3>& X) const {
   int bad = INT_MAX;
   std::visit(
       [&](const auto& W) {
-#pragma omp parallel for schedule(static) reduction(min : bad)
+#pragma omp parallel for schedule(static) reduction(min : bad) if (threaded_)
         for (int e = 0; e < E; ++e) {
           const Nodes x = element_nodes(elements_[e], X);
           const Vec3 chord = chord_normal(x);
@@ -447,7 +449,7 @@ std::vector<NodeStrain> ElasticMembrane::node_strain(const std::vector<Vec3>& X)
   const int E = static_cast<int>(num_elements());
   std::vector<Vec3> en_inv(6 * E);  // (A1, A2, (lambda1^2 - lambda2^2)/2) per element node
   int bad = INT_MAX;
-#pragma omp parallel for schedule(static) reduction(min : bad)
+#pragma omp parallel for schedule(static) reduction(min : bad) if (threaded_)
   for (int e = 0; e < E; ++e) {
     const Nodes x = element_nodes(elements_[e], X);
     const Vec3 chord = chord_normal(x);
@@ -480,7 +482,7 @@ std::vector<double> ElasticMembrane::node_area(const std::vector<Vec3>& X) const
   const int E = static_cast<int>(num_elements());
   std::vector<double> S(E);
   std::vector<std::array<double, 6>> frac(E);
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) if (threaded_)
   for (int e = 0; e < E; ++e) {
     const Nodes x = element_nodes(elements_[e], X);
     double s = 0;

@@ -96,6 +96,7 @@ class ElasticMembrane {
   std::vector<double> ref_node_;  ///< per element node: Gbar^{xx}, Gbar^{xe}, Gbar^{ee}, Jbar (4 doubles)
   std::vector<double> ref_quad_;  ///< per quadrature point: Gbar^{xx}, Gbar^{xe}, Gbar^{ee}, Jbar w
   std::vector<double> kappa_ref_;
+  bool threaded_ = false;  ///< large enough for OpenMP threads (kMinElementsForThreads)
   std::optional<CurvatureFit> fit_;  ///< nodal normal and curvature for the bending moments (kappa_B > 0)
 };
 

@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "immerse/membrane/MeshElement.hpp"
+#include "immerse/core/Parallel.hpp"
 
 namespace immerse {
 namespace {
@@ -51,7 +52,7 @@ VolumeMoments volume_moments(const Mesh& mesh, const std::vector<Vec3>& X, const
   // Per-element contributions in parallel, summed serially: the result does not depend on the thread count.
   std::vector<VolumeMoments> part(mesh.num_elements());
   const auto ne = static_cast<std::ptrdiff_t>(mesh.num_elements());
-#pragma omp parallel for
+#pragma omp parallel for if (ne >= kMinElementsForThreads)
   for (std::ptrdiff_t e = 0; e < ne; ++e) {
     const auto x = element_nodes(mesh, X, static_cast<std::size_t>(e), origin);
     VolumeMoments& m = part[e];
@@ -117,7 +118,7 @@ SymmetricEigen symmetric_eigen(Mat3 a) {
 double area(const Mesh& mesh, const std::vector<Vec3>& X) {
   std::vector<double> part(mesh.num_elements(), 0.0);
   const auto ne = static_cast<std::ptrdiff_t>(mesh.num_elements());
-#pragma omp parallel for
+#pragma omp parallel for if (ne >= kMinElementsForThreads)
   for (std::ptrdiff_t e = 0; e < ne; ++e) {
     const auto a = sub_triangle_areas(element_nodes(mesh, X, static_cast<std::size_t>(e), {}));
     part[e] = a[0] + a[1] + a[2] + a[3];
@@ -153,7 +154,7 @@ MembraneGeometry measure(const Mesh& mesh, const std::vector<Vec3>& X) {
 std::vector<double> node_area_weights(const Mesh& mesh, const std::vector<Vec3>& X) {
   std::vector<std::array<double, 4>> sub_area(mesh.num_elements());
   const auto ne = static_cast<std::ptrdiff_t>(mesh.num_elements());
-#pragma omp parallel for
+#pragma omp parallel for if (ne >= kMinElementsForThreads)
   for (std::ptrdiff_t e = 0; e < ne; ++e)
     sub_area[e] = sub_triangle_areas(element_nodes(mesh, X, static_cast<std::size_t>(e), {}));
   // Serial gather: the sums do not depend on the thread count.

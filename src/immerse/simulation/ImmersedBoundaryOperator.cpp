@@ -10,6 +10,8 @@
 #include <string>
 
 #include "immerse/core/Error.hpp"
+#include "immerse/core/Parallel.hpp"
+#include "immerse/fluid/MacGeom.hpp"
 #include "immerse/coupling/NodeDiagnostics.hpp"
 
 namespace immerse {
@@ -32,7 +34,7 @@ void parallel_assign(std::span<const T> src, std::vector<T>& dst) {
   const long n = static_cast<long>(src.size());
   T* const d = dst.data();
   const T* const s = src.data();
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) if (long(sizeof(T) / sizeof(double)) * n >= kMinValuesForThreads)
   for (long i = 0; i < n; ++i) d[i] = s[i];
 }
 
@@ -43,7 +45,7 @@ void blend(const Grid& g, double theta, const FaceField& a, const FaceField& b, 
     auto& o = out[d];
     const auto& x = a[d];
     const auto& y = b[d];
-#pragma omp parallel for
+#pragma omp parallel for if (MacGeom(g).threaded())
     for (std::size_t i = 0; i < o.size(); ++i) o[i] = theta * x[i] + (1.0 - theta) * y[i];
   }
 }
@@ -95,7 +97,7 @@ void ImmersedBoundaryOperator::nodal_force(std::size_t m, std::span<const Vec3> 
 // lowest-numbered failing membrane.
 void ImmersedBoundaryOperator::membrane_force_density(std::span<const Vec3> X, FaceField& f) {
   const int M = static_cast<int>(membranes_.size());
-  const bool across = M >= 2 * omp_get_max_threads();
+  const bool across = omp_get_max_threads() > 1 && M >= 2 * omp_get_max_threads();
   std::vector<std::exception_ptr> error(membranes_.size());
   auto one = [&](int m) {
     try {
@@ -123,27 +125,40 @@ void ImmersedBoundaryOperator::membrane_force_density(std::span<const Vec3> X, F
   timed(timings_.spread, [&] { coupler_.spread_force(X, F_, f); });
 }
 
-void ImmersedBoundaryOperator::trial_step(std::span<const double> Xf, double theta, double dt) {
+template <class F>
+void ImmersedBoundaryOperator::governed(F&& evaluation) {
+  governor_.choose();
+  const auto t0 = std::chrono::steady_clock::now();
+  const double occasional = evaluation();
+  governor_.record(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count() - occasional);
+}
+
+double ImmersedBoundaryOperator::trial_step(std::span<const double> Xf, double theta, double dt) {
   trial_X_.clear();
   trial_U_valid_ = false;
+  double occasional = 0;
   if (theta < 1.0 && !start_valid_) {
-    membrane_force_density(X_, force_start_);
+    timed(occasional, [&] { membrane_force_density(X_, force_start_); });
     start_valid_ = true;
   }
   membrane_force_density(nodes(Xf), force_);
   timed(timings_.fluid, [&] {
     if (theta < 1.0) blend(fluid_.grid(), theta, force_, force_start_, mixed_);
-    if (!prepared_.prepared_for(committed_, dt)) fluid_.prepare(committed_, dt, prepared_);
+    if (!prepared_.prepared_for(committed_, dt)) timed(occasional, [&] { fluid_.prepare(committed_, dt, prepared_); });
     fluid_.step(prepared_, theta < 1.0 ? mixed_ : force_, trial_);
   });
   ++solves_;
+  return occasional;
 }
 
 void ImmersedBoundaryOperator::trial_velocity(std::span<const double> Xf, double theta, std::span<const double> Xi,
                                               double dt, std::span<double> U) {
-  trial_step(Xf, theta, dt);
-  timed(timings_.interpolate, [&] {
-    coupler_.interpolate_velocity(trial_.u, nodes(Xi), {reinterpret_cast<Vec3*>(U.data()), U.size() / 3});
+  governed([&] {
+    const double occasional = trial_step(Xf, theta, dt);
+    timed(timings_.interpolate, [&] {
+      coupler_.interpolate_velocity(trial_.u, nodes(Xi), {reinterpret_cast<Vec3*>(U.data()), U.size() / 3});
+    });
+    return occasional;
   });
   trial_U_valid_ = Xi.data() == Xf.data() && Xi.size() == Xf.size();
   if (trial_U_valid_) parallel_assign<Vec3>(nodes(U), trial_U_);
@@ -152,10 +167,13 @@ void ImmersedBoundaryOperator::trial_velocity(std::span<const double> Xf, double
 
 void ImmersedBoundaryOperator::trial_mean_velocity(std::span<const double> Xf, std::span<const double> Xi, double dt,
                                                    std::span<double> U) {
-  trial_step(Xf, 1.0, dt);
-  timed(timings_.interpolate, [&] {
-    blend(fluid_.grid(), 0.5, trial_.u, committed_.u, mean_);
-    coupler_.interpolate_velocity(mean_, nodes(Xi), {reinterpret_cast<Vec3*>(U.data()), U.size() / 3});
+  governed([&] {
+    const double occasional = trial_step(Xf, 1.0, dt);
+    timed(timings_.interpolate, [&] {
+      blend(fluid_.grid(), 0.5, trial_.u, committed_.u, mean_);
+      coupler_.interpolate_velocity(mean_, nodes(Xi), {reinterpret_cast<Vec3*>(U.data()), U.size() / 3});
+    });
+    return occasional;
   });
   parallel_assign(Xf, trial_X_);
 }

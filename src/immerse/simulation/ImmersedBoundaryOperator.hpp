@@ -17,6 +17,7 @@
 #include <span>
 #include <vector>
 
+#include "immerse/core/ThreadGovernor.hpp"
 #include "immerse/coupling/IBCoupler.hpp"
 #include "immerse/fluid/NavierStokesSolver.hpp"
 #include "immerse/membrane/ElasticMembrane.hpp"
@@ -50,6 +51,9 @@ class ImmersedBoundaryOperator final : public CoupledOperator {
   const FluidState& fluid_state() const { return committed_; }
   /// Wall time spent so far in each part of the coupled step (since construction, which evaluates the forces once).
   const StepTimings& timings() const { return timings_; }
+  /// The policy that sets OpenMP's thread count before each evaluation of the residual (fixed by default).
+  void set_thread_governor(const ThreadGovernor& g) { governor_ = g; }
+  const ThreadGovernor& thread_governor() const { return governor_; }
   std::size_t num_membranes() const { return membranes_.size(); }
   /// Committed positions of membrane m.
   std::vector<Vec3> membrane_positions(std::size_t m) const;
@@ -73,7 +77,12 @@ class ImmersedBoundaryOperator final : public CoupledOperator {
   /// f = S(X) f(X) for all membranes.
   void membrane_force_density(std::span<const Vec3> X, FaceField& f);
   /// The fluid step of a trial: trial_ = the step from committed_ driven by F^{n+1/2} of (Xf, theta).
-  void trial_step(std::span<const double> Xf, double theta, double dt);
+  /// Returns the seconds spent on work that not every evaluation does (the start force, the fluid preparation),
+  /// which the thread governor leaves out of its comparison.
+  double trial_step(std::span<const double> Xf, double theta, double dt);
+  /// Runs one evaluation of the residual with the thread count the governor chooses, and reports its time.
+  template <class F>
+  void governed(F&& evaluation);
 
   NavierStokesSolver& fluid_;
   IBCoupler& coupler_;
@@ -99,6 +108,7 @@ class ImmersedBoundaryOperator final : public CoupledOperator {
   std::vector<std::vector<Vec3>> Xm_, Fm_;              ///< per-membrane scratch for compute_force
   std::size_t solves_ = 0;
   StepTimings timings_;
+  ThreadGovernor governor_;
 };
 
 static_assert(sizeof(Vec3) == 3 * sizeof(double), "positions are viewed as flat arrays of doubles");

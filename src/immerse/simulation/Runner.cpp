@@ -388,6 +388,7 @@ int run_command(const RunOptions& options, std::ostream& out, std::ostream& err)
     std::ostringstream took;  // its own stream: the precision set here must not reach the lines below
     took << std::fixed << std::setprecision(1) << "stepping took " << stepping << " s, ";
     out << took.str() << sim.op().timings().since(timings_at_start).profile(stepping, done) << "\n";
+    out << sim.op().thread_governor().summary() << "\n";
   }
   for (std::size_t m = 0; m < sim.num_membranes(); ++m) {
     const auto X = sim.op().membrane_positions(m);

@@ -104,6 +104,7 @@ std::string membrane_name(std::size_t m) { return "membrane[" + std::to_string(m
 Simulation::Simulation(const io::Config& config)
     : config_(config),
       grid_(make_grid(config)),
+      threads_(ThreadGovernor::from_environment()),
       fluid_(grid_, make_fluid(config),
              config.get<std::string>("fluid.fft_planning") == "measure" ? FftPlanning::Measure : FftPlanning::Estimate),
       coupler_(grid_, delta_kernel(config.get<std::string>("coupling.kernel"))),
@@ -113,6 +114,7 @@ Simulation::Simulation(const io::Config& config)
   std::vector<const ElasticMembrane*> ms;
   for (auto& m : membranes_) ms.push_back(m.get());
   op_ = std::make_unique<ImmersedBoundaryOperator>(fluid_, coupler_, ms, initial_, initial_fluid_state());
+  op_->set_thread_governor(threads_);
   integrator_ = make_integrator(config.get<std::string>("time.scheme"), make_settings(config));
   if (integrator_->name() == "bfgs" && op_->size() > DenseBfgs::max_unknowns)
     throw InputError("time.scheme = \"bfgs\": the dense quasi-Newton matrix of eq. (35) is limited to " +

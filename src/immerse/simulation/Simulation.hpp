@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include "immerse/core/ThreadGovernor.hpp"
 #include "immerse/coupling/IBCoupler.hpp"
 #include "immerse/fluid/NavierStokesSolver.hpp"
 #include "immerse/io/Checkpoint.hpp"
@@ -65,6 +66,7 @@ class Simulation {
 
   io::Config config_;
   Grid grid_;
+  ThreadGovernor threads_;  ///< first: sets OpenMP's thread count (cgroup quota) before the FFT plans are made
   NavierStokesSolver fluid_;
   IBCoupler coupler_;
   std::vector<Mesh> meshes_;

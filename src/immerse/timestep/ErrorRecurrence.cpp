@@ -6,6 +6,7 @@
 
 #include "immerse/core/Cholesky_K.hpp"
 #include "immerse/core/Error.hpp"
+#include "immerse/core/Parallel.hpp"
 
 namespace immerse {
 
@@ -17,7 +18,7 @@ void ErrorRecurrence::update_grams(const std::vector<std::size_t>& b) const {
   const std::size_t m = e_.size(), nblocks = b.size() - 1;
   if (gram_rows_ == m) return;
   grams_.resize(nblocks);
-#pragma omp parallel for schedule(dynamic)
+#pragma omp parallel for schedule(dynamic) if (nblocks > 1 && long(e_.back().size()) >= kMinValuesForThreads)
   for (std::size_t blk = 0; blk < nblocks; ++blk) {
     Gram& G = grams_[blk];
     for (std::size_t i = gram_rows_; i < m; ++i) {
@@ -107,8 +108,8 @@ void ErrorRecurrence::predict(double dt, std::span<double> X, std::span<const st
   const auto b = blocks(offsets);
   update_grams(b);
   const std::size_t m = e_.size(), nblocks = b.size() - 1;
-  // One block per thread, each summed in order: the prediction does not depend on the number of threads.
-#pragma omp parallel for schedule(dynamic)
+  // Blocks (membranes) in parallel, each summed in order: the prediction does not depend on the thread count.
+#pragma omp parallel for schedule(dynamic) if (nblocks > 1 && long(X.size()) >= kMinValuesForThreads)
   for (std::size_t k = 0; k < nblocks; ++k) {
     const Fit f = next_fit(grams_[k], b[k + 1] - b[k]);
     for (int p = 0; p < f.terms; ++p)

@@ -1,4 +1,5 @@
 #include "immerse/timestep/MembraneIntegrator.hpp"
+#include "immerse/core/Parallel.hpp"
 
 #include <cmath>
 
@@ -45,7 +46,7 @@ void MembraneIntegrator::remember(const CoupledOperator& op, double dt, std::spa
   if (!extrapolated_.empty() && X.size() == extrapolated_.size()) {
     const long n = static_cast<long>(X.size());
     double* const e = extrapolated_.data();
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) if (n >= kMinValuesForThreads)
     for (long i = 0; i < n; ++i) e[i] = X[i] - e[i];
     errors_.record(dt, extrapolated_);
   } else {

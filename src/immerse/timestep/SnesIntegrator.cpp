@@ -1,4 +1,5 @@
 #include "immerse/timestep/SnesIntegrator.hpp"
+#include "immerse/core/Parallel.hpp"
 
 #include <cmath>
 #include <sstream>
@@ -136,7 +137,7 @@ PetscErrorCode SnesIntegrator::form_function(SNES, Vec x, Vec f, void* ctx) {
   const long n = static_cast<long>(self->n_);
   const double scale = self->scale_;
   double* const X = self->X_.data();
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) if (n >= kMinValuesForThreads)
   for (long i = 0; i < n; ++i) X[i] = scale * xs[i];
   PetscCall(VecRestoreArrayRead(x, &xs));
   try {
@@ -147,7 +148,7 @@ PetscErrorCode SnesIntegrator::form_function(SNES, Vec x, Vec f, void* ctx) {
   }
   PetscCall(VecGetArray(f, &fs));
   const double* const g = self->g_.data();
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) if (n >= kMinValuesForThreads)
   for (long i = 0; i < n; ++i) fs[i] = g[i] / scale;
   PetscCall(VecRestoreArray(f, &fs));
   return 0;
@@ -212,7 +213,7 @@ StepStats SnesIntegrator::step(CoupledOperator& op, double dt) {
   {
     const long n = static_cast<long>(n_);
     const double* const X = X_.data();
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) if (n >= kMinValuesForThreads)
     for (long i = 0; i < n; ++i) xs[i] = X[i] / scale_;
   }
   IMMERSE_PETSC(VecRestoreArray(x_, &xs));

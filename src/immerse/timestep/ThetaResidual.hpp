@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "immerse/timestep/CoupledOperator.hpp"
+#include "immerse/core/Parallel.hpp"
 
 namespace immerse {
 
@@ -26,7 +27,7 @@ class ThetaResidual {
     const auto Xn = op_.positions();
     const auto Un = op_.node_velocity();
     const long n = static_cast<long>(X.size());
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) if (n >= kMinValuesForThreads)
     for (long i = 0; i < n; ++i) g[i] = X[i] - Xn[i] - dt_ * ((1.0 - theta_) * Un[i] + theta_ * U_[i]);
   }
   /// True when the operator's trial state was produced by exactly these positions (so it can be committed).
@@ -39,10 +40,10 @@ class ThetaResidual {
     const long n = static_cast<long>(Xn.size());
     if (previous.size() == Xn.size() && previous_dt > 0) {
       const double r = dt_ / previous_dt;
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) if (n >= kMinValuesForThreads)
       for (long i = 0; i < n; ++i) X0[i] = Xn[i] + r * (Xn[i] - previous[i]);
     } else {
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) if (n >= kMinValuesForThreads)
       for (long i = 0; i < n; ++i) X0[i] = Xn[i] + dt_ * Un[i];
     }
   }
