@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Builds the optimized programs and runs every benchmark in bench/, then prints one table: benchmark, measured
-# figure, its bound, the ratio, the goal (issue 6) and whether it is met. Raw results are kept in
+# figure, its bound, the ratio, the goal (docs/performance.md) and whether it is met. Raw results are kept in
 # build/release/bench/results/ (Google Benchmark JSON, and the text of the whole-run benchmarks).
 #   bash scripts/bench.sh              all benchmarks (whole runs bench_oscillating and bench_channel at their --quick
 #                                      size, the latter's explicit probes limited to 10 minutes: about 15 minutes)
@@ -8,7 +8,7 @@
 #                                      most of it explicit RK2 runs to t = 0.05 s, limited by --rk2-budget 3600)
 #   bash scripts/bench.sh FILTER       only the Google Benchmark cases matching the regex FILTER
 # Timings are wall-clock; the ratios are taken inside one program (fastest repetitions of the kernel and of its
-# bound), so they stand up to a shared machine better than the absolute figures, but 2-thread speedups need a
+# bound), so they stand up to a loaded machine better than the absolute figures, but 2-thread speedups need a
 # machine with two idle cores.
 set -euo pipefail
 cd "$(dirname "$0")/.."

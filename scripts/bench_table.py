@@ -1,6 +1,6 @@
 """Prints the table of scripts/bench.sh from the results in DIR (Google Benchmark JSON of bench_fluid,
 bench_coupling and bench_membrane, text of bench_oscillating): benchmark, measured figure, bound, ratio, goal, met.
-Goals are those of issue 6 (docs/performance.md). Usage: /usr/bin/python3 scripts/bench_table.py DIR"""
+Goals are those of docs/performance.md. Usage: /usr/bin/python3 scripts/bench_table.py DIR"""
 import json
 import os
 import re
@@ -54,7 +54,7 @@ def main(directory):
         if threads > 1 and (op, kernel, 1) in rates:
             s = r / rates[(op, kernel, 1)]
             row(rows, f"{op} {kernel}, speedup", s, "-", "-", ">= 1.7", s >= 1.7)
-    # Membrane forces: elements/s/core (docs/status.md goal 1e6) and 2-thread speedup.
+    # Membrane forces: elements/s/core (goal 1e6, docs/performance.md) and 2-thread speedup.
     for b in load(directory, "bench_membrane"):
         threads = int(re.search(r"threads:(\d+)", b["name"]).group(1))
         label = b.get("label", b["name"])

@@ -21,7 +21,7 @@ namespace {
 // test program skips HDF5's atexit shutdown (the process is ending anyway). Must run before any HDF5 call.
 const bool kNoHdf5Atexit = H5dont_atexit() >= 0;
 
-// Removes this program's scratch directory at the end.
+// Removes this program's temporary directory at the end.
 class ScratchCleanup : public ::testing::Environment {
  public:
   void TearDown() override {

@@ -20,7 +20,7 @@ namespace fs = std::filesystem;
 
 namespace {
 
-// Removes this program's scratch directory at the end.
+// Removes this program's temporary directory at the end.
 class ScratchCleanup : public ::testing::Environment {
  public:
   void TearDown() override {

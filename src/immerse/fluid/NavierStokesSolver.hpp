@@ -87,7 +87,7 @@ class NavierStokesSolver {
 
   /// Writes into `out` the state one step of size dt after `in` under the force `force` (F^{n+1/2} on the
   /// velocity faces; its wall faces are ignored). Pure: `in` is only read; `out` must be a different object
-  /// (it is sized on first use, then reused without allocation). Not reentrant: uses internal scratch.
+  /// (it is sized on first use, then reused without allocation). Not reentrant: uses internal work arrays.
   /// Bitwise the same as prepare(in, dt, p) then step(p, force, out), in one pass over the faces for (9).
   void step(const FluidState& in, const FaceField& force, double dt, FluidState& out);
 
@@ -101,7 +101,7 @@ class NavierStokesSolver {
   /// prepare(). `out` must not be the state prepared from (std::invalid_argument); that state must still have its
   /// step counter and time of prepare() (std::logic_error otherwise). (u·∇_h u)^n is copied into out.adv only when
   /// `out` does not hold it already from an earlier call after the same prepare() (FluidState::adv_of): the trials
-  /// of an implicit step, written into one output state, copy it once. Not reentrant: uses internal scratch.
+  /// of an implicit step, written into one output state, copy it once. Not reentrant: uses internal work arrays.
   void step(const PreparedStep& prepared, const FaceField& force, FluidState& out);
 
   /// Writes the normal wall velocity into the wall faces of u (the boundary condition (3)).

@@ -5,10 +5,10 @@
 //
 //   config run.toml:12:5: fluid.mu = -1: must be a finite number > 0
 //   config run.toml:3:1: unknown key fluid.muu (did you mean fluid.mu?)
-//   --set: time.scheme = "rk4": must be one of "jfnk", "quasi_newton", "euler", "rk2"
+//   --set: time.scheme = "rk4": must be one of "euler", "rk2", "jfnk", "bfgs", "lbfgs", "anderson"
 //
 // Repeated items are arrays of tables ([[membrane]]): each entry is validated against its own schema and named
-// membrane[i] in messages, getters and overrides (--set membrane[0].level=3).
+// membrane[i] in messages, getters and overrides (--set membrane[0].mesh.level=3).
 #include <cstdint>
 #include <filesystem>
 #include <iosfwd>
@@ -58,7 +58,7 @@ using ConfigValue = std::variant<double, std::int64_t, bool, std::string, std::v
 /// One declared key.
 struct KeySpec {
   enum class Kind { Double, Int, Bool, String, DoubleList, Vec3 };
-  std::string key;  // dotted name relative to its schema, e.g. "fluid.mu" or (in [[membrane]]) "law.Es"
+  std::string key;  // dotted name relative to its schema, e.g. "fluid.mu" or (in [[membrane]]) "mesh.level"
   Kind kind;
   ConfigValue default_value;
   Range range = Range::any();

@@ -27,10 +27,10 @@
 // Jacobian J = I - (dt/2) dU/dX has its spectrum close to 1 on the error left by the initial guess (soft cells:
 // §4.4 at mu0 = 10 uN/m) that saves about one solve per step. On stiff membranes (J's spectrum far from 1) the
 // fixed-point step amplifies the stiff modes and the mixing converges slowly or not at all: there JFNK is the robust
-// choice (docs/performance.md, "Session 11").
+// choice (docs/time-integration.md, "Anderson acceleration").
 //
 // Positions are measured in the operator's length scale inside the solver, so that eq. (37)'s perturbation is
-// relative to the geometry whatever the physical units (numerics notes: keep the norms scaled).
+// relative to the geometry whatever the physical units (docs/theory/numerics-notes.md, "The implicit step").
 // Every PETSc option stays overridable through SolverSettings::petsc_options.
 #include <petscsnes.h>
 
