@@ -191,8 +191,15 @@ INSTANTIATE_TEST_SUITE_P(
                  "membrane[0].mesh.file: must be a Gmsh file name when mesh.family = \"file\""},
         BadInput{"shear_without_walls", "", {"scenario.kind=\"capsule_shear\"", "boundary.z=\"periodic\""}, "",
                  "boundary.z: must be \"wall\" for scenario.kind = \"capsule_shear\""},
-        BadInput{"derived_modulus_overflows", "", {"scenario.kind=\"capsule_shear\"", "scenario.G=1e-320"}, "",
-                 "scenario.kind = \"capsule_shear\" derives membrane[0].Es = inf: must be a finite number > 0"},
+        BadInput{"derived_group_overflows", "", {"scenario.kind=\"capsule_shear\"", "membrane[0].Es=1e-320"}, "",
+                 "scenario.G = inf: must be a finite number > 0 (derived: scenario.kind = \"capsule_shear\" from "
+                 "membrane[0].Es"},
+        BadInput{"derived_key_conflicts_with_its_group", "", {"scenario.kind=\"capsule_shear\"", "scenario.G=0.1"}, "",
+                 "membrane[0].Es = 0.1 conflicts with scenario.G = 0.1 (scenario.kind = \"capsule_shear\" derives "
+                 "membrane[0].Es = "},
+        BadInput{"wall_velocity_set_by_the_shear_kind", "",
+                 {"scenario.kind=\"capsule_shear\"", "boundary.z_upper_velocity=[1,0,0]"}, "",
+                 "boundary.z_upper_velocity = [1.0, 0.0, 0.0]: scenario.kind = \"capsule_shear\" sets it to "},
         BadInput{"truncated_mesh", "",
                  {"membrane[0].mesh.family=\"file\"", "membrane[0].mesh.file=\"SUITE/truncated.msh\""}, "",
                  "truncated.msh: truncated or malformed file while reading $Elements"},

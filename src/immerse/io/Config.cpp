@@ -18,16 +18,46 @@ Config::Config(std::shared_ptr<const ConfigSchema> schema) : schema_(std::move(s
 
 std::string Config::value_text(std::string_view key) const { return format_toml(value(key)); }
 
-const ConfigValue& Config::value(std::string_view key) const {
+std::pair<const Config*, std::string_view> Config::locate(std::string_view key) const {
   if (const auto br = key.find('['); br != std::string_view::npos) {
     const auto close = key.find(']', br);
     if (close == std::string_view::npos || close + 2 > key.size() || key[close + 1] != '.')
       throw std::logic_error("config: malformed key '" + std::string(key) + "'");
     const std::size_t i = std::stoul(std::string(key.substr(br + 1, close - br - 1)));
-    return entry(key.substr(0, br), i).value(key.substr(close + 2));
+    return {&entry(key.substr(0, br), i), key.substr(close + 2)};
   }
-  const auto it = values_.find(key);
-  if (it == values_.end()) throw std::logic_error("config: key '" + std::string(key) + "' is not declared");
+  return {this, key};
+}
+
+bool Config::given(std::string_view key) const {
+  const auto [c, k] = locate(key);
+  c->value(k);  // declared
+  return c->given_.contains(k);
+}
+
+std::string Config::derivation(std::string_view key) const {
+  const auto [c, k] = locate(key);
+  const auto it = c->derivations_.find(k);
+  return it == c->derivations_.end() ? std::string() : it->second;
+}
+
+void Config::derive(const std::string& key, const std::string& value_text, const std::string& how) {
+  const std::string assignment = key + "=" + value_text;
+  try {
+    schema_->apply_derived(*this, {&assignment, 1});
+  } catch (const InputError& e) {
+    std::string m = e.what();
+    if (m.rfind("--set: ", 0) == 0) m = m.substr(7);
+    throw InputError(m + " (derived: " + how + ")");
+  }
+  const auto [c, k] = locate(key);
+  const_cast<Config*>(c)->derivations_[std::string(k)] = how;
+}
+
+const ConfigValue& Config::value(std::string_view key) const {
+  const auto [c, k] = locate(key);
+  const auto it = c->values_.find(k);
+  if (it == c->values_.end()) throw std::logic_error("config: key '" + std::string(key) + "' is not declared");
   return it->second;
 }
 
@@ -101,6 +131,7 @@ void Config::write_toml(std::string& out, const std::string& section) const {
   // Inside a [[table]] entry (section non-empty) every key is written as it is declared.
   const auto line = [&](const KeySpec& k, const std::string& written_key) {
     out += "# " + k.doc + "; " + k.allowed() + "; default " + format_toml(k.default_value) + "\n";
+    if (const auto d = derivations_.find(k.key); d != derivations_.end()) out += "# derived: " + d->second + "\n";
     out += written_key + " = " + format_toml(values_.find(k.key)->second) + "\n";
   };
   if (!section.empty()) {

@@ -4,9 +4,11 @@
 #include <cstdint>
 #include <filesystem>
 #include <map>
+#include <set>
 #include <memory>
 #include <string>
 #include <string_view>
+#include <utility>
 #include <vector>
 
 #include "immerse/io/ConfigSchema.hpp"
@@ -35,7 +37,17 @@ class Config {
   /// Writes to_toml_string() to `path` atomically (e.g. DIR/config.resolved.toml).
   void save(const std::filesystem::path& path) const;
 
+  /// Whether the user gave `key` (in the file or with --set), as opposed to a default or a derived value.
+  bool given(std::string_view key) const;
+  /// How a derived key got its value ("scenario.kind = \"capsule_shear\" from scenario.G, ..."), empty if it was
+  /// not derived. Written as a comment above the key by to_toml_string().
+  std::string derivation(std::string_view key) const;
+  /// Sets a key to a derived value (TOML text, as an override) and records how it was derived; the key does not
+  /// count as given. InputError ("KEY = VALUE: must be ... (derived: HOW)") if the value is out of range.
+  void derive(const std::string& key, const std::string& value_text, const std::string& how);
+
   const ConfigSchema& schema() const { return *schema_; }
+  /// Equal values (whether given or derived does not count).
   bool operator==(const Config& other) const;
 
  private:
@@ -44,11 +56,15 @@ class Config {
   explicit Config(std::shared_ptr<const ConfigSchema> schema);
   const ConfigValue& value(std::string_view key) const;
   ConfigValue& value_ref(const std::string& key);
+  /// The entry config and the key inside it of "name[i].key"; this and `key` for a plain key.
+  std::pair<const Config*, std::string_view> locate(std::string_view key) const;
   void write_toml(std::string& out, const std::string& section) const;
 
   std::shared_ptr<const ConfigSchema> schema_;
   std::map<std::string, ConfigValue, std::less<>> values_;
   std::map<std::string, std::vector<Config>, std::less<>> tables_;
+  std::set<std::string, std::less<>> given_;                        // keys of this table the user gave
+  std::map<std::string, std::string, std::less<>> derivations_;     // derived keys of this table: how
 };
 
 template <> double Config::get<double>(std::string_view key) const;

@@ -273,6 +273,7 @@ class ConfigResolver {
       const std::string name = display + key;
       if (const KeySpec* spec = s.find(key)) {
         out.values_[key] = convert(*spec, node, name, where(source, node.source()), given(node));
+        out.given_.insert(key);
       } else if (const auto* ta = s.find_table_array(key)) {
         const toml::array* a = node.as_array();
         if (!a || !(a->empty() || a->is_array_of_tables()))
@@ -311,7 +312,7 @@ class ConfigResolver {
     return false;
   }
 
-  static void set(const ConfigSchema& s, Config& cfg, const std::string& assignment) {
+  static void set(const ConfigSchema& s, Config& cfg, const std::string& assignment, bool given) {
     const auto eq = assignment.find('=');
     if (eq == std::string::npos) throw InputError("--set " + assignment + ": must be KEY=VALUE");
     const std::string key = trim(std::string_view(assignment).substr(0, eq));
@@ -349,6 +350,7 @@ class ConfigResolver {
     if (spec->kind == KeySpec::Kind::String && (text.empty() || (text[0] != '"' && text[0] != '\''))) {
       if (!spec->valid(text)) reject("--set", key, format_toml(text), *spec);
       target->values_[rel] = text;
+      if (given) target->given_.insert(rel);
       return;
     }
     toml::table parsed;
@@ -360,6 +362,7 @@ class ConfigResolver {
     const toml::node* node = parsed.get("v");
     if (!node || parsed.size() != 1) reject("--set", key, text, *spec);
     target->values_[rel] = convert(*spec, *node, key, "--set", text);
+    if (given) target->given_.insert(rel);
   }
 
   static void check_counts(const ConfigSchema& s, const Config& cfg, const std::string& origin) {
@@ -376,7 +379,13 @@ Config ConfigSchema::defaults() const { return Config(std::make_shared<const Con
 
 void ConfigSchema::apply_overrides(Config& config, std::span<const std::string> overrides) const {
   Config updated = config;
-  for (const auto& o : overrides) ConfigResolver::set(*this, updated, o);
+  for (const auto& o : overrides) ConfigResolver::set(*this, updated, o, true);
+  config = std::move(updated);
+}
+
+void ConfigSchema::apply_derived(Config& config, std::span<const std::string> assignments) const {
+  Config updated = config;
+  for (const auto& a : assignments) ConfigResolver::set(*this, updated, a, false);
   config = std::move(updated);
 }
 

@@ -92,8 +92,11 @@ class ConfigSchema {
   /// As parse_file, from TOML text; `source` names it in messages ("config <source>:line:col: ...").
   Config parse_string(std::string_view toml, const std::string& source,
                       std::span<const std::string> overrides = {}) const;
-  /// Applies "key=value" overrides to a resolved configuration (messages start with "--set: ").
+  /// Applies "key=value" overrides to a resolved configuration (messages start with "--set: "); the keys count as
+  /// given by the user.
   void apply_overrides(Config& config, std::span<const std::string> overrides) const;
+  /// As apply_overrides, for values derived from others (the keys do not count as given).
+  void apply_derived(Config& config, std::span<const std::string> assignments) const;
 
   /// Every key with its default, what is allowed and its doc string (for --help-config).
   void print_help(std::ostream& os) const;

@@ -1,6 +1,12 @@
 #include "immerse/simulation/Scenario.hpp"
 
+#include <algorithm>
+#include <cctype>
+#include <cmath>
 #include <cstdio>
+#include <cstdlib>
+#include <sstream>
+#include <utility>
 #include <string>
 #include <vector>
 
@@ -12,6 +18,11 @@ namespace {
 std::string num(double v) {
   char buf[64];
   std::snprintf(buf, sizeof buf, "%.17g", v);
+  return buf;
+}
+std::string brief(double v) {  // for messages
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "%.6g", v);
   return buf;
 }
 bool is_shear(const std::string& kind) {
@@ -43,78 +54,174 @@ std::vector<Vec3> channel_cell_centres(const io::Config& c) {
 
 namespace {
 
-// Writes the derived values into their keys; one out of range (an extreme group overflowing or underflowing) is
-// reported as the scenario's, naming the keys it came from.
-io::Config with_derived(const io::Config& config, const std::vector<std::string>& set, const std::string& kind,
-                        const std::string& sources) {
-  io::Config derived = config;
-  try {
-    config.schema().apply_overrides(derived, set);
-  } catch (const InputError& e) {
-    std::string m = e.what();
-    if (m.rfind("--set: ", 0) == 0) m = m.substr(7);
-    throw InputError("scenario.kind = \"" + kind + "\" derives " + m + " (from " + sources + ")");
+/// The numbers in a value's TOML text ("4e-06", "[1.0, 2.0, 3.0]"), and the rest of the text.
+std::pair<std::vector<double>, std::string> split_numbers(const std::string& text) {
+  std::vector<double> numbers;
+  std::string rest;
+  for (std::size_t i = 0; i < text.size();) {
+    char* end = nullptr;
+    const double v = std::strtod(text.c_str() + i, &end);
+    const bool number = end != text.c_str() + i && (std::isdigit(static_cast<unsigned char>(text[i])) || text[i] == '-' ||
+                                                   text[i] == '+' || text[i] == '.');
+    if (number) {
+      numbers.push_back(v);
+      i = static_cast<std::size_t>(end - text.c_str());
+    } else {
+      rest += text[i++];
+    }
+  }
+  return {numbers, rest};
+}
+
+/// Equal values up to the round-off of deriving one from the other (relative 1e-9).
+bool same_value(const std::string& a, const std::string& b) {
+  const auto [x, xr] = split_numbers(a);
+  const auto [y, yr] = split_numbers(b);
+  if (xr != yr || x.size() != y.size()) return false;
+  for (std::size_t i = 0; i < x.size(); ++i)
+    if (std::abs(x[i] - y[i]) > 1e-9 * std::max(std::abs(x[i]), std::abs(y[i]))) return false;
+  return true;
+}
+
+/// Writes a scenario kind's derived values into the keys the user left unset; a key the user gave keeps its value.
+/// Where a derived key and the group it comes from are both given and disagree, that is an error naming both.
+class Derivation {
+ public:
+  Derivation(const io::Config& config, const std::string& kind) : c_(config), kind_("scenario.kind = \"" + kind + "\"") {}
+
+  /// `key` = text (`what` it is) unless the user gave it (then the user's value stays).
+  void fill(const std::string& key, const std::string& text, const std::string& what) {
+    if (!c_.given(key)) c_.derive(key, text, kind_ + ": " + what);
+  }
+
+  /// `key` = text (`what` it is); a value the user gave must be that one.
+  void fix(const std::string& key, const std::string& text, const std::string& what, const std::string& instead) {
+    if (c_.given(key) && !same_value(c_.value_text(key), text))
+      throw InputError(key + " = " + c_.value_text(key) + ": " + kind_ + " sets it to " + text + " (" + what +
+                       "); leave it unset" + instead);
+    c_.derive(key, text, kind_ + ": " + what);
+  }
+
+  /// A key and the nondimensional group it follows from: key = forward(group). The user may give either; the other
+  /// is derived (the group back from the key by `inverse`); both given must agree.
+  template <class Forward, class Inverse>
+  void pair(const std::string& key, const std::string& group, const std::string& other_sources, Forward forward,
+            Inverse inverse) {
+    const bool key_given = c_.given(key), group_given = c_.given(group);
+    const double derived = forward(c_.get<double>(group));
+    if (key_given && group_given) {
+      if (!same_value(c_.value_text(key), num(derived)))
+        throw InputError(key + " = " + c_.value_text(key) + " conflicts with " + group + " = " +
+                         c_.value_text(group) + " (" + kind_ + " derives " + key + " = " + brief(derived) + " from it" +
+                         (other_sources.empty() ? "" : " and " + other_sources) + "): give only one of them");
+    } else if (key_given) {
+      c_.derive(group, num(inverse(c_.get<double>(key))),
+                kind_ + " from " + key + (other_sources.empty() ? "" : ", " + other_sources));
+    } else {
+      c_.derive(key, num(derived), kind_ + " from " + group + (other_sources.empty() ? "" : ", " + other_sources));
+    }
+  }
+
+  const io::Config& config() const { return c_; }
+  io::Config take() { return std::move(c_); }
+
+ private:
+  io::Config c_;
+  std::string kind_;
+};
+
+std::string vec(const Vec3& p) {
+  std::ostringstream s;  // a stream: GCC 12 warns (-Wrestrict) on this as a chain of string concatenations
+  s << '[' << num(p.x) << ", " << num(p.y) << ", " << num(p.z) << ']';
+  return s.str();
+}
+
+Vec3 box_centre(const io::Config& c) {
+  const Vec3 o = c.get<Vec3>("domain.origin");
+  return {o.x + 0.5 * c.get<double>("domain.Lx"), o.y + 0.5 * c.get<double>("domain.Ly"),
+          o.z + 0.5 * c.get<double>("domain.Lz")};
+}
+
+// Shear scenarios (see the header): E_s, kappa_B, time.dt and time.end from G, kappa_B_hat, k_dt and kt_end (or the
+// groups back from the keys the user gave), the walls moving with -+ k Lz / 2, the capsule at the box centre.
+io::Config derive_shear(const io::Config& config, const std::string& kind) {
+  if (config.count("membrane") != 1) throw InputError("scenario.kind = \"" + kind + "\": needs exactly one [[membrane]]");
+  require(config.get<std::string>("boundary.z") == "wall", "boundary.z", "\"wall\" for scenario.kind = \"" + kind + "\"");
+  Derivation d(config, kind);
+  const double a = config.get<double>("membrane[0].radius"), mu = config.get<double>("fluid.mu");
+  const double k = shear_rate(config), Lz = config.get<double>("domain.Lz");
+  const std::string rate = "scenario.Re, fluid.mu, fluid.rho, membrane[0].radius";
+  const std::string own = "; for other walls use scenario.kind = \"none\"";
+  d.fill("membrane[0].law", "\"neo_hookean\"", "the neo-Hookean capsule of §4.2");
+  d.pair("membrane[0].Es", "scenario.G", rate, [&](double G) { return mu * k * a / G; },
+         [&](double Es) { return mu * k * a / Es; });
+  const double Es = d.config().get<double>("membrane[0].Es");
+  d.pair("membrane[0].kappa_B", "scenario.kappa_B_hat", "membrane[0].Es, membrane[0].radius",
+         [&](double hat) { return hat * a * a * Es; }, [&](double kB) { return kB / (a * a * Es); });
+  d.fill("membrane[0].center", vec(box_centre(config)), "the box centre");
+  const std::string flow = "the shear flow u = (k (z - z_c), 0, 0), k from " + rate;
+  d.fix("boundary.z_lower_velocity", vec({-0.5 * k * Lz, 0, 0}), flow, own);
+  d.fix("boundary.z_upper_velocity", vec({0.5 * k * Lz, 0, 0}), flow, own);
+  d.fill("fluid.initial", "\"couette\"", "the undisturbed shear flow");
+  d.pair("time.dt", "scenario.k_dt", rate, [&](double kdt) { return kdt / k; }, [&](double dt) { return k * dt; });
+  d.pair("time.end", "scenario.kt_end", rate, [&](double kt) { return kt / k; }, [&](double t) { return k * t; });
+  if (kind == "oblate_shear") {
+    d.fix("membrane[0].shape", "\"oblate\"", "the oblate capsule of §4.2.2", "");
+    const auto same = [](double x) { return x; };
+    d.pair("membrane[0].aspect_ratio", "scenario.aspect_ratio", "", same, same);
+    d.pair("membrane[0].inclination", "scenario.theta0", "", same, same);
+  }
+  return d.take();
+}
+
+// rbc_stretch, rbc_channel: the biconcave cell with the Yeoh law, C10 = mu0/2, C30 = mu0/30; the channel copies the
+// cell to the 32 positions of channel_cell_centres.
+io::Config derive_cells(const io::Config& config, const std::string& kind) {
+  if (config.count("membrane") != 1)
+    throw InputError("scenario.kind = \"" + kind + "\": needs exactly one [[membrane]] (" +
+                     (kind == "rbc_channel" ? "the template of every cell" : "the cell") + "), given " +
+                     std::to_string(config.count("membrane")));
+  Derivation d(config, kind);
+  d.fix("membrane[0].shape", "\"rbc\"", "the biconcave cell of eq. (45)", "");
+  d.fill("membrane[0].law", "\"yeoh\"", "the Yeoh law of §4.3");
+  d.pair("membrane[0].C10", "scenario.mu0", "", [](double mu0) { return mu0 / 2; }, [](double C10) { return 2 * C10; });
+  const double mu0 = d.config().get<double>("scenario.mu0");
+  d.fill("membrane[0].C30", num(mu0 / 30), "C30 = mu0 / 30 from scenario.mu0");
+  if (kind == "rbc_stretch") return d.take();
+  for (const auto& [axis, bc] : {std::pair{"x", "wall"}, {"y", "periodic"}, {"z", "wall"}})
+    require(config.get<std::string>(std::string("boundary.") + axis) == bc, std::string("boundary.") + axis,
+            std::string("\"") + bc + "\" for scenario.kind = \"rbc_channel\" (flow along the periodic y axis)");
+  const auto centres = channel_cell_centres(config);
+  const std::string arrangement = "the channel's arrangement of 32 cells in the domain";
+  d.fix("membrane[0].center", vec(centres[0]), arrangement, "; for other positions use scenario.kind = \"none\"");
+  io::Config derived = d.take();
+  const io::Config cell = derived.entry("membrane", 0);
+  const std::string how = "scenario.kind = \"rbc_channel\" from membrane[0] and " + arrangement;
+  for (std::size_t i = 1; i < centres.size(); ++i) {
+    const std::string prefix = "membrane[" + std::to_string(i) + "].";
+    for (const auto& key : cell.schema().keys())
+      if (key.key != "center") derived.derive(prefix + key.key, cell.value_text(key.key), how);
+    derived.derive(prefix + "center", vec(centres[i]), how);
   }
   return derived;
 }
 
-// The dimensional values the scenario kind implies, written into their keys.
+// Any kind: a generated membrane whose centre is not given sits at the box centre.
+io::Config derive_centres(io::Config config) {
+  for (std::size_t i = 0; i < config.count("membrane"); ++i) {
+    const std::string p = "membrane[" + std::to_string(i) + "].";
+    if (!config.given(p + "center") && config.derivation(p + "center").empty() &&
+        config.get<std::string>(p + "mesh.family") != "file")
+      config.derive(p + "center", vec(box_centre(config)), "the box centre (" + p + "center not given)");
+  }
+  return config;
+}
+
 io::Config derive(const io::Config& config) {
   const std::string kind = config.get<std::string>("scenario.kind");
-  if (kind == "rbc_stretch" || kind == "rbc_channel") {
-    if (config.count("membrane") != 1)
-      throw InputError("scenario.kind = \"" + kind + "\": needs exactly one [[membrane]] (" +
-                       (kind == "rbc_channel" ? "the template of every cell" : "the cell") + "), given " +
-                       std::to_string(config.count("membrane")));
-    const double mu0 = config.get<double>("scenario.mu0");
-    io::Config derived =
-        with_derived(config,
-                     {"membrane[0].shape=\"rbc\"", "membrane[0].law=\"yeoh\"", "membrane[0].C10=" + num(mu0 / 2),
-                      "membrane[0].C30=" + num(mu0 / 30)},
-                     kind, "scenario.mu0");
-    if (kind == "rbc_stretch") return derived;
-    for (const auto& [axis, bc] : {std::pair{"x", "wall"}, {"y", "periodic"}, {"z", "wall"}})
-      require(config.get<std::string>(std::string("boundary.") + axis) == bc, std::string("boundary.") + axis,
-              std::string("\"") + bc + "\" for scenario.kind = \"rbc_channel\" (flow along the periodic y axis)");
-    const io::Config& cell = derived.entry("membrane", 0);
-    const auto centres = channel_cell_centres(config);
-    std::vector<std::string> set;
-    for (std::size_t i = 0; i < centres.size(); ++i) {
-      const std::string prefix = "membrane[" + std::to_string(i) + "].";
-      if (i > 0)
-        for (const auto& key : cell.schema().keys()) set.push_back(prefix + key.key + "=" + cell.value_text(key.key));
-      const Vec3& p = centres[i];
-      set.push_back(prefix + "center=[" + num(p.x) + "," + num(p.y) + "," + num(p.z) + "]");
-    }
-    return with_derived(derived, set, kind, "membrane[0] and the domain");
-  }
-  if (!is_shear(kind)) return config;
-  if (config.count("membrane") != 1) throw InputError("scenario.kind = \"" + kind + "\": needs exactly one [[membrane]]");
-  require(config.get<std::string>("boundary.z") == "wall", "boundary.z", "\"wall\" for scenario.kind = \"" + kind + "\"");
-  const double a = config.get<double>("membrane[0].radius"), mu = config.get<double>("fluid.mu");
-  const double k = shear_rate(config), Es = mu * k * a / config.get<double>("scenario.G");
-  const double Lz = config.get<double>("domain.Lz");
-  const Vec3 o = config.get<Vec3>("domain.origin");
-  const Vec3 centre = {o.x + 0.5 * config.get<double>("domain.Lx"), o.y + 0.5 * config.get<double>("domain.Ly"),
-                       o.z + 0.5 * Lz};
-  std::vector<std::string> set = {
-      "membrane[0].law=\"neo_hookean\"",
-      "membrane[0].Es=" + num(Es),
-      "membrane[0].kappa_B=" + num(config.get<double>("scenario.kappa_B_hat") * a * a * Es),
-      "membrane[0].center=[" + num(centre.x) + "," + num(centre.y) + "," + num(centre.z) + "]",
-      "boundary.z_lower_velocity=[" + num(-0.5 * k * Lz) + ",0,0]",
-      "boundary.z_upper_velocity=[" + num(0.5 * k * Lz) + ",0,0]",
-      "fluid.initial=\"couette\"",
-      "time.dt=" + num(config.get<double>("scenario.k_dt") / k),
-      "time.end=" + num(config.get<double>("scenario.kt_end") / k),
-  };
-  if (kind == "oblate_shear") {
-    set.push_back("membrane[0].shape=\"oblate\"");
-    set.push_back("membrane[0].aspect_ratio=" + num(config.get<double>("scenario.aspect_ratio")));
-    set.push_back("membrane[0].inclination=" + num(config.get<double>("scenario.theta0")));
-  }
-  return with_derived(config, set, kind,
-                      "scenario.G, scenario.Re, scenario.k_dt, scenario.kt_end, fluid.mu, fluid.rho, membrane[0].radius");
+  if (kind == "rbc_stretch" || kind == "rbc_channel") return derive_centres(derive_cells(config, kind));
+  if (is_shear(kind)) return derive_centres(derive_shear(config, kind));
+  return derive_centres(config);
 }
 
 }  // namespace
