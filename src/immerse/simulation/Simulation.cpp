@@ -288,6 +288,34 @@ void Simulation::check_stability(const StepRecord& r) const {
       throw SimulationError(s.str());
     }
   }
+  // The fluid everywhere in the box, also where no membrane samples it.
+  const FluidState& f = op_->fluid_state();
+  auto unstable_at = [&](const Array3& a, std::size_t n, const std::string& what, const std::string& symbol,
+                         const char* where) {
+    const std::size_t i = n % std::size_t(a.nx()), j = n / std::size_t(a.nx()) % std::size_t(a.ny()),
+                      k = n / (std::size_t(a.nx()) * std::size_t(a.ny()));
+    std::ostringstream s;
+    s.precision(10);
+    s << "unstable at step " << r.step << ", t = " << r.time << ": fluid " << what << " at " << where << " (" << i
+      << ", " << j << ", " << k << ") ";
+    const double v = a.values()[n];
+    if (std::isfinite(v))
+      s << "exceeds time.max_speed (runaway) (|" << symbol << "| = " << std::abs(v) << " m/s, bound " << vmax << ")";
+    else
+      s << "is not finite";
+    throw SimulationError(s.str());
+  };
+  for (int d = 0; d < 3; ++d) {
+    const auto& u = f.u[d].values();
+    for (std::size_t n = 0; n < u.size(); ++n)
+      if (!(std::abs(u[n]) <= vmax)) {
+        const std::string u_d = std::string("u_") + kAxes[d];
+        unstable_at(f.u[d], n, "velocity " + u_d, u_d, "face");
+      }
+  }
+  const auto& p = f.p.values();
+  for (std::size_t n = 0; n < p.size(); ++n)
+    if (!std::isfinite(p[n])) unstable_at(f.p, n, "pressure", "p", "cell");
 }
 
 io::Checkpoint Simulation::checkpoint() const {
