@@ -246,7 +246,8 @@ FluidState Simulation::initial_fluid_state() const {
 
 bool Simulation::finished() const { return time() >= config_.get<double>("time.end") * (1 - 1e-12); }
 
-StepRecord Simulation::advance(const std::function<void(const std::string&)>& log) {
+StepRecord Simulation::advance(const std::function<void(const std::string&)>& log,
+                               const std::function<bool()>& stop_requested) {
   const auto t0 = std::chrono::steady_clock::now();
   const double remaining = config_.get<double>("time.end") - time();
   StepRecord r;
@@ -255,7 +256,7 @@ StepRecord Simulation::advance(const std::function<void(const std::string&)>& lo
   where << "step " << step_ + 1 << ", t = " << time() << ": ";
   try {
     const auto acc = stepper_.advance(*integrator_, *op_, remaining,
-                                      [&](const std::string& msg) { log(where.str() + msg); });
+                                      [&](const std::string& msg) { log(where.str() + msg); }, stop_requested);
     r.stats = acc.stats;
     r.dt = acc.dt;
     r.rejected = acc.rejected;
