@@ -183,6 +183,12 @@ INSTANTIATE_TEST_SUITE_P(
         BadInput{"folder_given_to_restart", "", {}, "good", "good is a folder: must name a checkpoint file (e.g. "},
         BadInput{"end_before_checkpoint", "", {}, "good/checkpoint.h5",
                  "time.end = 0.125: must be later than the time of the checkpoint "},
+        BadInput{"set_without_key", "", {"="}, "", "--set =: must be KEY=VALUE (no key given; see --help-config)"},
+        BadInput{"config_beyond_size_limit", "/dev/zero", {}, "",
+                 "config /dev/zero: larger than 1 MiB: not a configuration file"},
+        BadInput{"wall_velocity_on_periodic_axis", "", {"boundary.y=\"periodic\"", "boundary.y_upper_velocity=[1,0,0]"},
+                 "", "boundary.y_upper_velocity = [1.0, 0.0, 0.0]: must be [0, 0, 0] when boundary.y = \"periodic\" (a "
+                     "wall velocity needs walls)"},
         BadInput{"fields_every_beyond_32_bits", "", {"output.fields_every=3000000000"}, "",
                  "output.fields_every = 3000000000: must be a 32-bit integer"},
         BadInput{"restart_into_new_folder_with_frames", "", {"time.end=0.5", "output.fields_every=1"},
