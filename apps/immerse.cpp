@@ -78,7 +78,8 @@ int main(int argc, char** argv) {
     }
     if (*run && run_opts.file.empty()) throw immerse::InputError("run: a configuration FILE.toml is required");
     if (*run && restart->count() > 0 && run_opts.restart.empty())
-      throw immerse::InputError("--restart: an empty name was given: must name a checkpoint file (e.g. out/checkpoint.h5)");
+      throw immerse::InputError(
+          "--restart: an empty name was given: must name a checkpoint file (e.g. out/checkpoint.h5)");
     immerse::PetscSession petsc;
     if (*run) {
       const int status = immerse::run_command(run_opts, std::cout, std::cerr);

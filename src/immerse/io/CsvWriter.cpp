@@ -48,7 +48,8 @@ CsvWriter::CsvWriter(std::filesystem::path path, std::vector<std::string> column
   for (const auto& c : columns_)
     if (c.empty() || c.find_first_of(",\"\n\r") != std::string::npos)
       throw std::logic_error("CsvWriter " + path_.string() + ": bad column name '" + c + "'");
-  if (mode != Mode::Append || !check_continuable(path_, columns_)) AtomicFile::write(path_, header_line(columns_) + "\n");
+  if (mode != Mode::Append || !check_continuable(path_, columns_))
+    AtomicFile::write(path_, header_line(columns_) + "\n");
   fd_ = ::open(path_.c_str(), O_WRONLY | O_APPEND | O_CLOEXEC);
   if (fd_ < 0) cannot_write(path_, errno);
 }

@@ -141,7 +141,8 @@ void write_frame(io::XdmfWriter& writer, const Simulation& sim) {
 
 // The header and the data rows r = 0, 1, ... of a CSV file for which keep(r, first number of the row) holds (a
 // restart continues after the checkpoint); nothing if the file does not exist. Reads only.
-std::optional<std::string> rows_to_keep(const std::filesystem::path& path, const std::function<bool(long, double)>& keep) {
+std::optional<std::string> rows_to_keep(const std::filesystem::path& path,
+                                        const std::function<bool(long, double)>& keep) {
   std::ifstream in(path);
   if (!in) return std::nullopt;
   std::string line, kept;
@@ -326,7 +327,8 @@ int run_command(const RunOptions& options, std::ostream& out, std::ostream& err)
   std::optional<std::string> kept_diagnostics, kept_stretch;
   if (in_place) {
     io::CsvWriter::check_continuable(dir / "diagnostics.csv", columns);
-    kept_diagnostics = rows_to_keep(dir / "diagnostics.csv", [&](long, double step) { return step <= double(sim.step()); });
+    kept_diagnostics =
+        rows_to_keep(dir / "diagnostics.csv", [&](long, double step) { return step <= double(sim.step()); });
     if (sweep) {
       io::CsvWriter::check_continuable(dir / "stretch.csv", stretch_columns);
       kept_stretch = rows_to_keep(dir / "stretch.csv", [&](long row, double) { return row < long(sweep->current()); });

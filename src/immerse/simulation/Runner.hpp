@@ -1,9 +1,10 @@
 #pragma once
-// `immerse run FILE.toml [--set key=value ...] [--out DIR] [--restart CHECKPOINT] [--overwrite]`: reads and validates the whole
-// configuration and builds the run before anything is written; then prints and saves the resolved configuration,
-// runs the time loop with its scheduled callbacks (diagnostics.csv, ParaView frames, checkpoints, progress), and
-// stops cleanly on instability or SIGINT/SIGTERM/SIGHUP/SIGQUIT with a last checkpoint and frame. The output
-// folder is locked while the run writes, and a folder holding another run is refused unless continued or replaced.
+// `immerse run FILE.toml [--set key=value ...] [--out DIR] [--restart CHECKPOINT] [--overwrite]`: reads and validates
+// the whole configuration and builds the run before anything is written; then prints and saves the resolved
+// configuration, runs the time loop with its scheduled callbacks (diagnostics.csv, ParaView frames, checkpoints,
+// progress), and stops cleanly on instability or SIGINT/SIGTERM/SIGHUP/SIGQUIT with a last checkpoint and frame.
+// The output folder is locked while the run writes, and a folder holding another run is refused unless continued or
+// replaced.
 #include <filesystem>
 #include <iosfwd>
 #include <string>

@@ -398,7 +398,8 @@ void Simulation::restore(const io::Checkpoint& ck) {
       ck.invalid(name, "has " + std::to_string(values.size()) + " values, this configuration needs " +
                            std::to_string(size));
     for (std::size_t i = 0; i < values.size(); ++i)
-      if (!std::isfinite(values[i])) ck.invalid(name, "has a value that is not finite (index " + std::to_string(i) + ")");
+      if (!std::isfinite(values[i]))
+        ck.invalid(name, "has a value that is not finite (index " + std::to_string(i) + ")");
     return values;
   };
   FluidState f = fluid_.initial_state();
@@ -433,7 +434,8 @@ void Simulation::restore(const io::Checkpoint& ck) {
   const double prev_dt = time_value("integrator.previous_dt");
   // Checkpoints written before the initial-guess recurrence have no guess errors: it then starts afresh.
   const std::string errors = "integrator.guess_errors";
-  const std::vector<double> guess_errors = ck.has(errors) ? array(errors, ck.array(errors).size()) : std::vector<double>{};
+  const std::vector<double> guess_errors =
+      ck.has(errors) ? array(errors, ck.array(errors).size()) : std::vector<double>{};
   const double nominal = config_.get<double>("time.dt"), dt = ck.get_double("stepper.dt");
   number("stepper.dt", dt, std::isfinite(dt) && dt > 0 && dt <= nominal, "in (0, time.dt]");
   const std::int64_t successes = count("stepper.successes");
