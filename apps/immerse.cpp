@@ -1,5 +1,10 @@
 // immerse: implicit immersed-boundary simulation of elastic membranes in 3D incompressible flow.
 #include <CLI/CLI.hpp>
+#include <fcntl.h>
+#include <unistd.h>
+
+#include <csignal>
+#include <cstdio>
 #include <filesystem>
 #include <iostream>
 
@@ -58,7 +63,11 @@ int main(int argc, char** argv) {
   run->add_option("--set", run_opts.sets, "Override a key: --set scenario.G=0.05 (repeatable; dotted names as in the file)");
   run->add_option("--out", run_opts.out, "Output folder (diagnostics.csv, config.resolved.toml, ParaView frames, checkpoint.h5)")
       ->capture_default_str();
-  run->add_option("--restart", run_opts.restart, "Continue from a checkpoint written by the same configuration");
+  auto* restart = run->add_option("--restart", run_opts.restart,
+                                  "Continue from a checkpoint written by the same configuration (in its folder: "
+                                  "continues that run's files)");
+  run->add_flag("--overwrite", run_opts.overwrite,
+                "Replace the run already in the --out folder (its files are removed first; other files are kept)");
   run->add_flag("--help-config", help_config, "List every configuration key with its default, range and meaning");
   auto* scenarios = app.add_subcommand("scenarios", "List the bundled scenario files");
 
@@ -85,8 +94,22 @@ int main(int argc, char** argv) {
       return 0;
     }
     if (*run && run_opts.file.empty()) throw immerse::InputError("run: a configuration FILE.toml is required");
+    if (*run && restart->count() > 0 && run_opts.restart.empty())
+      throw immerse::InputError(
+          "--restart: an empty name was given: must name a checkpoint file (e.g. out/checkpoint.h5)");
     immerse::PetscSession petsc;
-    if (*run) return immerse::run_command(run_opts, std::cout, std::cerr);
+    if (*run) {
+      const int status = immerse::run_command(run_opts, std::cout, std::cerr);
+      // The outcome is decided and reported: a late stop request must not turn it into death by signal.
+      for (int sig : {SIGINT, SIGTERM, SIGHUP, SIGQUIT, SIGPIPE}) std::signal(sig, SIG_IGN);
+      // A standard output that was closed (`| head`) is not an error of the run: what is left goes nowhere.
+      if (!std::cout || std::fflush(stdout) != 0) {
+        std::cout.clear();
+        std::clearerr(stdout);
+        if (const int null = open("/dev/null", O_WRONLY); null >= 0) dup2(null, STDOUT_FILENO);
+      }
+      return status;
+    }
     if (*verify) return run_verify(study, quick);
   } catch (const immerse::InputError& e) {
     std::cerr << "immerse: error: " << e.what() << "\n";

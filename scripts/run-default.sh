@@ -5,4 +5,4 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/build.sh release
-./build/release/immerse run scenarios/capsule_shear_quick.toml --out out/capsule_shear_quick
+./build/release/immerse run scenarios/capsule_shear_quick.toml --out out/capsule_shear_quick --overwrite

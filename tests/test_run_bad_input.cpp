@@ -3,7 +3,9 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstring>
+#include <functional>
 
 #include "immerse/io/Checkpoint.hpp"
 #include "immerse/membrane/MeshGenerator.hpp"
@@ -84,6 +86,22 @@ class BadInputTest : public ::testing::TestWithParam<BadInput> {
     const std::string whole = read_text(ck);
     std::ofstream(dir / "truncated.h5", std::ios::binary) << whole.substr(0, whole.size() / 2);
 
+    // Damaged entries under a valid checksum (the checkpoint rewritten with one entry replaced).
+    auto rewritten = [&](const std::string& name, const std::function<void(io::Checkpoint&)>& put) {
+      io::Checkpoint c = io::Checkpoint::read(ck);
+      c.erase(name);
+      put(c);
+      c.write(dir / (name + ".h5"));
+    };
+    rewritten("step", [](io::Checkpoint& c) { c.put_int("step", -5); });
+    rewritten("fluid.u0", [](io::Checkpoint& c) { c.put_array("fluid.u0", std::vector<double>(10, 0.0)); });
+    const auto positions = io::Checkpoint::read(ck).array("membrane[0].positions");
+    rewritten("membrane[0].positions", [&](io::Checkpoint& c) {
+      auto p = positions;
+      p[4] = std::nan("");
+      c.put_array("membrane[0].positions", p, {p.size() / 3, 3});
+    });
+
     // The quick scenario with its [[membrane]] table repeated: two membranes at the same centre.
     const std::string base = read_text(scenario_file("oscillating_membrane_quick.toml"));
     std::ofstream(dir / "two_membranes.toml") << base << "\n" << base.substr(base.find("[[membrane]]"));
@@ -160,6 +178,29 @@ INSTANTIATE_TEST_SUITE_P(
         BadInput{"corrupted_checkpoint", "", {}, "flipped.h5", "flipped.h5 is corrupted: checksum mismatch"},
         BadInput{"truncated_checkpoint", "", {}, "truncated.h5", "truncated.h5 is truncated or not an HDF5 file"},
         BadInput{"missing_checkpoint", "", {}, "no_such_checkpoint.h5", "no_such_checkpoint.h5"},
+        BadInput{"empty_restart", "", {}, "", "--restart: an empty name was given: must name a checkpoint file",
+                 {"--restart", ""}},
+        BadInput{"folder_given_to_restart", "", {}, "good", "good is a folder: must name a checkpoint file (e.g. "},
+        BadInput{"end_before_checkpoint", "", {}, "good/checkpoint.h5",
+                 "time.end = 0.125: must be later than the time of the checkpoint "},
+        BadInput{"set_without_key", "", {"="}, "", "--set =: must be KEY=VALUE (no key given; see --help-config)"},
+        BadInput{"config_beyond_size_limit", "/dev/zero", {}, "",
+                 "config /dev/zero: larger than 1 MiB: not a configuration file"},
+        BadInput{"wall_velocity_on_periodic_axis", "", {"boundary.y=\"periodic\"", "boundary.y_upper_velocity=[1,0,0]"},
+                 "", "boundary.y_upper_velocity = [1.0, 0.0, 0.0]: must be [0, 0, 0] when boundary.y = \"periodic\" (a "
+                     "wall velocity needs walls)"},
+        BadInput{"fields_every_beyond_32_bits", "", {"output.fields_every=3000000000"}, "",
+                 "output.fields_every = 3000000000: must be a 32-bit integer"},
+        BadInput{"restart_into_new_folder_with_frames", "", {"time.end=0.5", "output.fields_every=1"},
+                 "good/checkpoint.h5",
+                 "good/checkpoint.h5 with output.fields_every = 1: the ParaView series continues in the checkpoint's "
+                 "own folder (use --out "},
+        BadInput{"checkpoint_negative_step", "", {"time.end=0.5"}, "step.h5",
+                 "step.h5: step = -5: must be an integer >= 0"},
+        BadInput{"checkpoint_array_too_short", "", {"time.end=0.5"}, "fluid.u0.h5",
+                 "fluid.u0.h5: fluid.u0 has 10 values, this configuration needs 4352"},
+        BadInput{"checkpoint_nan_position", "", {"time.end=0.5"}, "membrane[0].positions.h5",
+                 "membrane[0].positions.h5: membrane[0].positions has a value that is not finite (index 4)"},
         // docs/robustness.md: the hand-tried table.
         BadInput{"boolean_for_a_number", "", {"fluid.mu=true"}, "", "fluid.mu = true: must be a finite number > 0"},
         BadInput{"config_is_a_folder", "good", {}, "", "good: cannot read: Is a directory"},
@@ -274,4 +315,13 @@ TEST(BadInputMissing, ShearScenarioWithoutItsMembraneTable) {
   EXPECT_EQ(r.status, 2) << r.err;
   EXPECT_EQ(r.err, "immerse: error: scenario.kind = \"capsule_shear\": needs exactly one [[membrane]]\n");
   EXPECT_FALSE(fs::exists(out));
+}
+
+// An empty --out (an unset shell variable) names no folder.
+TEST(BadInputOptions, EmptyOutputFolderIsRefused) {
+  ScratchDir scratch("bad_input");
+  const auto r = run_immerse({"run", scenario_file("oscillating_membrane_quick.toml").string(), "--out", ""},
+                             scratch / "run");
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_EQ(r.err, "immerse: error: --out: an empty name was given: must name a folder\n");
 }

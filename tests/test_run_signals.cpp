@@ -65,7 +65,94 @@ TEST_P(SignalTest, StopsWithStatus4AndACheckpointThatContinuesBitwise) {
             without_wall_clock(read_csv(out / "diagnostics.csv")));
 }
 
-INSTANTIATE_TEST_SUITE_P(Run, SignalTest, ::testing::Values(SIGTERM, SIGINT),
-                         [](const auto& p) { return p.param == SIGTERM ? "SIGTERM" : "SIGINT"; });
+INSTANTIATE_TEST_SUITE_P(Run, SignalTest, ::testing::Values(SIGTERM, SIGINT, SIGHUP, SIGQUIT), [](const auto& p) {
+  return p.param == SIGTERM ? "SIGTERM" : p.param == SIGINT ? "SIGINT" : p.param == SIGHUP ? "SIGHUP" : "SIGQUIT";
+});
+
+/// Waits until `csv` holds the header and `rows` rows (or the run ended, or 60 s passed: a failed expectation).
+void wait_for_rows(ImmerseProcess& p, const fs::path& csv, std::size_t rows) {
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
+  while (rows_written(csv) < 1 + rows) {
+    ASSERT_LT(std::chrono::steady_clock::now(), deadline) << "no diagnostics rows written:\n" << p.err();
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+}
 
 }  // namespace
+
+// SIGTERM every few milliseconds from the first rows to the end, so that some arrive while the checkpoint is
+// written and while the program finishes: it still ends with status 4 and a checkpoint that reads back.
+TEST(SignalStorm, RepeatedSigtermStillEndsWithStatus4AndAValidCheckpoint) {
+  ScratchDir dir("signal");
+  const fs::path out = dir / "out";
+  ImmerseProcess p(run_args(scenario_file("oscillating_membrane_quick.toml"), out, small_membrane_sets(kLongRun)),
+                   dir / "run");
+  wait_for_rows(p, out / "diagnostics.csv", kRowsBeforeSignal);
+  int status = -1;
+  for (int i = 0; i < 20000 && status < 0; ++i) {
+    p.signal(SIGTERM);
+    std::this_thread::sleep_for(std::chrono::milliseconds(2));
+    status = p.try_wait();
+  }
+  ASSERT_EQ(status, 4) << p.err();
+  const auto ck = io::Checkpoint::read(out / "checkpoint.h5");
+  EXPECT_EQ(std::stol(read_csv(out / "diagnostics.csv").back()[0]), ck.get_int("step"));
+}
+
+// A step that is rejected and halved again and again (one Newton iteration allowed, a tolerance no iterate meets):
+// a SIGTERM stops it between two attempts, without waiting for the step to be accepted; the checkpoint holds the
+// last accepted state (step 0).
+TEST(SignalHalving, StopRequestIsHonouredBetweenAttemptsOfAHalvedStep) {
+  ScratchDir dir("signal");
+  const fs::path out = dir / "out";
+  auto sets = small_membrane_sets(8);
+  sets.insert(sets.end(), {"solver.max_newton_its=1", "solver.newton_rtol=1e-300", "time.dt_min=1e-300"});
+  ImmerseProcess p(run_args(scenario_file("oscillating_membrane_quick.toml"), out, sets), dir / "run");
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
+  while (p.out().find("step 1, t = 0: step rejected with dt = ") == std::string::npos) {
+    ASSERT_LT(std::chrono::steady_clock::now(), deadline) << "no rejected step:\n" << p.out() << p.err();
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+  p.signal(SIGTERM);
+  ASSERT_EQ(p.wait(), 4) << p.err();
+  EXPECT_NE(p.err().find("immerse: interrupted by signal 15 at step 0, t = 0; checkpoint written to"), std::string::npos)
+      << p.err();
+  EXPECT_EQ(io::Checkpoint::read(out / "checkpoint.h5").get_int("step"), 0);
+}
+
+// A second run into the folder of a run that is still writing is refused (one line, status 2) and changes nothing.
+TEST(SignalConcurrent, SecondRunIntoAFolderInUseIsRefused) {
+  ScratchDir dir("signal");
+  const fs::path out = dir / "out";
+  const fs::path file = scenario_file("oscillating_membrane_quick.toml");
+  ImmerseProcess first(run_args(file, out, small_membrane_sets(kLongRun)), dir / "first");
+  wait_for_rows(first, out / "diagnostics.csv", 1);
+  const std::string config = read_text(out / "config.resolved.toml");
+  auto args = run_args(file, out, small_membrane_sets(1));
+  args.push_back("--overwrite");  // not even a replacement is allowed while the folder is in use
+  const auto second = run_immerse(args, dir / "second");
+  EXPECT_EQ(second.status, 2) << second.err;
+  EXPECT_EQ(second.err, "immerse: error: --out " + out.string() +
+                            " is in use by another immerse run (one run per output folder; wait for it or choose "
+                            "another --out)\n");
+  EXPECT_EQ(second.out, "");
+  EXPECT_EQ(read_text(out / "config.resolved.toml"), config);
+  first.signal(SIGTERM);
+  EXPECT_EQ(first.wait(), 4) << first.err();
+}
+
+// Standard output closed by its reader (`immerse run ... | head -1`): the run goes on without it, with no report
+// of a broken pipe, and ends normally.
+TEST(SignalPipe, ClosedStandardOutputDoesNotStopTheRun) {
+  ScratchDir dir("signal");
+  const fs::path out = dir / "out";
+  int fds[2];
+  ASSERT_EQ(pipe(fds), 0);
+  close(fds[0]);
+  ImmerseProcess p(run_args(scenario_file("oscillating_membrane_quick.toml"), out, small_membrane_sets(3)), dir / "run",
+                   {}, fds[1]);
+  close(fds[1]);
+  EXPECT_EQ(p.wait(), 0) << p.err();
+  EXPECT_EQ(p.err(), "");
+  EXPECT_EQ(io::Checkpoint::read(out / "checkpoint.h5").get_int("step"), 3);
+}

@@ -60,8 +60,9 @@ inline std::string read_text(const fs::path& path) {
 class ImmerseProcess {
  public:
   /// `env`: NAME=VALUE entries set for the child (replacing inherited ones of the same name); a bare NAME removes it.
+  /// `stdout_fd` >= 0: the child's standard output goes there (e.g. a pipe) instead of the log file.
   ImmerseProcess(const std::vector<std::string>& args, const fs::path& log_prefix,
-                 const std::vector<std::string>& env = {})
+                 const std::vector<std::string>& env = {}, int stdout_fd = -1)
       : out_(log_prefix.string() + ".stdout"), err_(log_prefix.string() + ".stderr") {
     std::vector<std::string> argv_s{immerse_program().string()};
     argv_s.insert(argv_s.end(), args.begin(), args.end());
@@ -93,7 +94,10 @@ class ImmerseProcess {
     posix_spawn_file_actions_t actions;
     posix_spawn_file_actions_init(&actions);
     posix_spawn_file_actions_addopen(&actions, STDIN_FILENO, "/dev/null", O_RDONLY, 0);
-    posix_spawn_file_actions_addopen(&actions, STDOUT_FILENO, out_.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    if (stdout_fd >= 0)
+      posix_spawn_file_actions_adddup2(&actions, stdout_fd, STDOUT_FILENO);
+    else
+      posix_spawn_file_actions_addopen(&actions, STDOUT_FILENO, out_.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
     posix_spawn_file_actions_addopen(&actions, STDERR_FILENO, err_.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
     const int rc = posix_spawn(&pid_, argv[0], &actions, nullptr, argv.data(), envp.data());
     posix_spawn_file_actions_destroy(&actions);
@@ -113,6 +117,13 @@ class ImmerseProcess {
   int wait() {
     int st = 0;
     waitpid(pid_, &st, 0);
+    pid_ = -1;
+    return WIFEXITED(st) ? WEXITSTATUS(st) : 128 + WTERMSIG(st);
+  }
+  /// The status as wait() gives it if the program has ended, -1 while it runs.
+  int try_wait() {
+    int st = 0;
+    if (waitpid(pid_, &st, WNOHANG) != pid_) return -1;
     pid_ = -1;
     return WIFEXITED(st) ? WEXITSTATUS(st) : 128 + WTERMSIG(st);
   }

@@ -45,3 +45,39 @@ TEST(RunUnstable, ExplicitSchemePastItsLimitStopsWithStatus3) {
 }
 
 }  // namespace
+
+namespace {
+
+/// The quick scenario without its membrane, on a 16^3 grid, with `sets` added: a box of fluid only.
+RunResult run_fluid_only(const ScratchDir& dir, const std::vector<std::string>& sets) {
+  const std::string base = read_text(scenario_file("oscillating_membrane_quick.toml"));
+  std::ofstream(dir / "fluid_only.toml") << base.substr(0, base.find("[[membrane]]"));
+  std::vector<std::string> all{"grid.nx=16", "grid.ny=16", "grid.nz=16", "time.dt=0.125", "time.end=1.0",
+                               "output.fields_every=0"};
+  all.insert(all.end(), sets.begin(), sets.end());
+  return run_immerse(run_args(dir / "fluid_only.toml", dir / "out", all), dir / "run");
+}
+
+}  // namespace
+
+// A fluid that overflows (a body force near the largest double) where no membrane samples it: status 3 at the
+// first step, naming the fluid, the face and what is wrong; the unstable state is kept for inspection.
+TEST(RunUnstable, FluidThatTurnsNonFiniteStopsWithStatus3) {
+  ScratchDir dir("unstable");
+  const auto r = run_fluid_only(dir, {"fluid.body_force=[1e308,0,0]"});
+  ASSERT_EQ(r.status, 3) << r.out << r.err;
+  const std::regex line(R"(immerse: run stopped: unstable at step 1, t = 0.125: fluid velocity u_x at face )"
+                        R"(\(\d+, \d+, \d+\) is not finite\n)");
+  EXPECT_TRUE(std::regex_match(r.err, line)) << r.err;
+  EXPECT_EQ(io::Checkpoint::read(dir / "out" / "checkpoint.h5").get_int("step"), 1);
+}
+
+// A fluid accelerated past time.max_speed (a body force along a periodic axis): status 3 with the speed found.
+TEST(RunUnstable, FluidFasterThanTheSpeedBoundStopsWithStatus3) {
+  ScratchDir dir("unstable");
+  const auto r = run_fluid_only(dir, {"fluid.body_force=[1e4,0,0]", "boundary.x=\"periodic\""});
+  ASSERT_EQ(r.status, 3) << r.out << r.err;
+  const std::regex line(R"(immerse: run stopped: unstable at step 1, t = 0.125: fluid velocity u_x at face )"
+                        R"(\(\d+, \d+, \d+\) exceeds time\.max_speed \(runaway\) \(\|u_x\| = [0-9.e+]+ m/s, bound 100\)\n)");
+  EXPECT_TRUE(std::regex_match(r.err, line)) << r.err;
+}

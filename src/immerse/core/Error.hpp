@@ -27,6 +27,13 @@ class SimulationError : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
+/// A stop asked for (by a signal) while a rejected step was to be retried: the state is that of the last accepted
+/// step, nothing of the retried one is committed.
+class StopRequested : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
 /// Throws InputError("<name> = <value>: must be <allowed>") unless ok.
 void require(bool ok, const std::string& name, double value, const std::string& allowed);
 /// Throws InputError("<name>: must be <allowed>") unless ok.

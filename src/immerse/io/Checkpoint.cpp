@@ -65,6 +65,17 @@ void Checkpoint::put_string(const std::string& name, std::string value) {
   strings_[name] = std::move(value);
 }
 
+void Checkpoint::erase(const std::string& name) {
+  arrays_.erase(name);
+  ints_.erase(name);
+  doubles_.erase(name);
+  strings_.erase(name);
+}
+
+void Checkpoint::invalid(const std::string& name, const std::string& what) const {
+  throw InputError("checkpoint " + source_ + ": " + name + " " + what);
+}
+
 bool Checkpoint::has(const std::string& name) const {
   return arrays_.contains(name) || ints_.contains(name) || doubles_.contains(name) || strings_.contains(name);
 }

@@ -26,13 +26,21 @@ class Checkpoint {
   void put_double(const std::string& name, double value);
   void put_string(const std::string& name, std::string value);
 
+  /// Removes an entry of any kind (nothing if there is none).
+  void erase(const std::string& name);
+
   bool has(const std::string& name) const;
+  /// Throws InputError "checkpoint <source>: <name> <what>", for entries that are present but unusable.
+  [[noreturn]] void invalid(const std::string& name, const std::string& what) const;
   /// The getters throw InputError "checkpoint <source>: no <kind> named <name>" for a missing entry.
   const std::vector<double>& array(const std::string& name) const;
   const std::vector<std::size_t>& shape(const std::string& name) const;
   std::int64_t get_int(const std::string& name) const;
   double get_double(const std::string& name) const;
   const std::string& get_string(const std::string& name) const;
+
+  /// The file it was read from ("(in memory)" for one built by the program).
+  const std::string& source() const { return source_; }
 
   /// FNV-1a-64 over every entry in canonical order (kind, then name).
   std::uint64_t checksum() const;

@@ -317,6 +317,7 @@ class ConfigResolver {
     if (eq == std::string::npos) throw InputError("--set " + assignment + ": must be KEY=VALUE");
     const std::string key = trim(std::string_view(assignment).substr(0, eq));
     const std::string text = trim(std::string_view(assignment).substr(eq + 1));
+    if (key.empty()) throw InputError("--set " + assignment + ": must be KEY=VALUE (no key given; see --help-config)");
 
     const ConfigSchema* schema = &s;
     Config* target = &cfg;
@@ -422,6 +423,11 @@ Config ConfigSchema::parse_file(const std::filesystem::path& file, std::span<con
     }
     if (n == 0) break;
     text.append(buf, static_cast<std::size_t>(n));
+    if (text.size() > kMaxFileBytes) {
+      ::close(fd);
+      throw InputError("config " + file.string() + ": larger than " + std::to_string(kMaxFileBytes >> 20) +
+                       " MiB: not a configuration file");
+    }
   }
   ::close(fd);
   return parse_string(text, file.string(), overrides);

@@ -86,6 +86,9 @@ class ConfigSchema {
 
   /// Every key at its default, no repeated-table entries.
   Config defaults() const;
+  /// Largest configuration file read (a few kB is usual): beyond it the file is refused, not read to its end.
+  static constexpr std::size_t kMaxFileBytes = std::size_t{1} << 20;
+
   /// Reads and validates a TOML file, then applies the overrides ("key=value", value in TOML syntax; string
   /// keys also take bare text). Throws InputError on any bad input.
   Config parse_file(const std::filesystem::path& file, std::span<const std::string> overrides = {}) const;

@@ -28,25 +28,28 @@ std::string header_line(const std::vector<std::string>& columns) {
 
 }  // namespace
 
+bool CsvWriter::check_continuable(const std::filesystem::path& path, const std::vector<std::string>& columns) {
+  std::error_code ec;
+  if (!std::filesystem::exists(path, ec)) return false;
+  const std::string header = header_line(columns);
+  std::ifstream in(path);
+  std::string found;
+  if (!in || !std::getline(in, found))
+    throw InputError("cannot continue " + path.string() + ": " + (in ? "file is empty" : std::strerror(errno)));
+  if (found != header)
+    throw InputError("cannot continue " + path.string() + ": header is \"" + found + "\", this run writes \"" +
+                     header + "\"");
+  return true;
+}
+
 CsvWriter::CsvWriter(std::filesystem::path path, std::vector<std::string> columns, Mode mode)
     : path_(std::move(path)), columns_(std::move(columns)) {
   if (columns_.empty()) throw std::logic_error("CsvWriter " + path_.string() + ": no columns");
   for (const auto& c : columns_)
     if (c.empty() || c.find_first_of(",\"\n\r") != std::string::npos)
       throw std::logic_error("CsvWriter " + path_.string() + ": bad column name '" + c + "'");
-  const std::string header = header_line(columns_);
-  std::error_code ec;
-  if (mode == Mode::Append && std::filesystem::exists(path_, ec)) {
-    std::ifstream in(path_);
-    std::string found;
-    if (!in || !std::getline(in, found))
-      throw InputError("cannot continue " + path_.string() + ": " + (in ? "file is empty" : std::strerror(errno)));
-    if (found != header)
-      throw InputError("cannot continue " + path_.string() + ": header is \"" + found + "\", this run writes \"" +
-                       header + "\"");
-  } else {
-    AtomicFile::write(path_, header + "\n");
-  }
+  if (mode != Mode::Append || !check_continuable(path_, columns_))
+    AtomicFile::write(path_, header_line(columns_) + "\n");
   fd_ = ::open(path_.c_str(), O_WRONLY | O_APPEND | O_CLOEXEC);
   if (fd_ < 0) cannot_write(path_, errno);
 }

@@ -25,6 +25,10 @@ class CsvWriter {
   void row(std::span<const double> values);
   void row(std::initializer_list<double> values) { row(std::span<const double>(values.begin(), values.size())); }
 
+  /// Whether `path` exists with the header of `columns` (false: it does not exist; InputError as for Mode::Append
+  /// if it exists with another header or none). Reads only.
+  static bool check_continuable(const std::filesystem::path& path, const std::vector<std::string>& columns);
+
   const std::filesystem::path& path() const { return path_; }
   const std::vector<std::string>& columns() const { return columns_; }
 

@@ -17,6 +17,7 @@
 #include "immerse/core/Error.hpp"
 #include "immerse/io/AtomicFile.hpp"
 #include "immerse/io/CsvWriter.hpp"
+#include "immerse/io/OutputFolder.hpp"
 #include "immerse/io/XdmfWriter.hpp"
 #include "immerse/membrane/Geometry.hpp"
 #include "immerse/simulation/Callback.hpp"
@@ -59,11 +60,12 @@ void write_frame(io::XdmfWriter& writer, const Simulation& sim) {
   writer.write_frame(sim.time(), frames, sim.config().get<bool>("output.fluid_fields") ? &fluid : nullptr);
 }
 
-// Keeps the header and the data rows r = 0, 1, ... of a CSV file for which keep(r, first number of the row) holds
-// (a restart continues after the checkpoint).
-void keep_rows(const std::filesystem::path& path, const std::function<bool(long, double)>& keep) {
+// The header and the data rows r = 0, 1, ... of a CSV file for which keep(r, first number of the row) holds (a
+// restart continues after the checkpoint); nothing if the file does not exist. Reads only.
+std::optional<std::string> rows_to_keep(const std::filesystem::path& path,
+                                        const std::function<bool(long, double)>& keep) {
   std::ifstream in(path);
-  if (!in) return;
+  if (!in) return std::nullopt;
   std::string line, kept;
   for (long r = -1; std::getline(in, line); ++r) {
     if (r >= 0) {
@@ -76,7 +78,38 @@ void keep_rows(const std::filesystem::path& path, const std::function<bool(long,
     }
     kept += line + "\n";
   }
-  io::AtomicFile::write(path, kept);
+  return kept;
+}
+
+// Signal dispositions while a run is on: SIGINT, SIGTERM, SIGHUP and SIGQUIT ask for a stop (checkpoint, exit 4);
+// SIGPIPE is ignored, so that a closed standard output (`immerse run ... | head`) only silences the log. The
+// previous dispositions come back at the end.
+class StopSignals {
+ public:
+  StopSignals() {
+    g_stop_signal = 0;
+    for (std::size_t i = 0; i < kSignals.size(); ++i) {
+      struct sigaction a {};
+      a.sa_handler = kSignals[i] == SIGPIPE ? SIG_IGN : on_signal;
+      a.sa_flags = SA_RESTART;
+      sigemptyset(&a.sa_mask);
+      sigaction(kSignals[i], &a, &saved_[i]);
+    }
+  }
+  ~StopSignals() {
+    for (std::size_t i = 0; i < kSignals.size(); ++i) sigaction(kSignals[i], &saved_[i], nullptr);
+  }
+  StopSignals(const StopSignals&) = delete;
+  StopSignals& operator=(const StopSignals&) = delete;
+
+ private:
+  static constexpr std::array<int, 5> kSignals{SIGINT, SIGTERM, SIGHUP, SIGQUIT, SIGPIPE};
+  std::array<struct sigaction, 5> saved_{};
+};
+
+bool same_folder(const std::filesystem::path& a, const std::filesystem::path& b) {
+  std::error_code ec;
+  return std::filesystem::equivalent(a.parent_path().empty() ? "." : a.parent_path(), b, ec) && !ec;
 }
 
 class Progress {
@@ -156,10 +189,15 @@ void list_scenarios(const std::filesystem::path& dir, std::ostream& out) {
 }
 
 int run_command(const RunOptions& options, std::ostream& out, std::ostream& err) {
+  StopSignals signals;
   // 1. Everything that can be wrong with the input is found before anything is written.
+  if (options.out.empty()) throw InputError("--out: an empty name was given: must name a folder");
+  const bool restarted = !options.restart.empty();
+  if (restarted && std::filesystem::is_directory(options.restart))
+    throw InputError("--restart " + options.restart.string() + " is a folder: must name a checkpoint file (e.g. " +
+                     (options.restart / "checkpoint.h5").string() + ")");
   const io::ConfigSchema schema = run_schema();
   const io::Config config = apply_scenario(schema.parse_file(options.file, options.sets));
-  const bool restarted = !options.restart.empty();
   check_memory(config);
   std::unique_ptr<Simulation> built;
   try {
@@ -177,45 +215,86 @@ int run_command(const RunOptions& options, std::ostream& out, std::ostream& err)
   } else if (sweep) {
     sweep->start(sim, 0);
   }
-  std::error_code ec;
-  std::filesystem::create_directories(options.out, ec);
-  if (ec) throw WriteError("cannot write " + options.out.string() + ": " + ec.message());
-  const std::filesystem::path dir = options.out;
-  // A restart continues the tables after the checkpoint (a damaged table is refused before anything is rewritten).
-  if (restarted) {
-    keep_rows(dir / "diagnostics.csv", [&](long, double step) { return step <= double(sim.step()); });
-    if (sweep) keep_rows(dir / "stretch.csv", [&](long row, double) { return row < long(sweep->current()); });
-  }
-
-  out << "# immerse " << IMMERSE_VERSION << ": " << options.file.string() << " -> " << dir.string() << "\n"
-      << "# resolved configuration (saved as config.resolved.toml)\n"
-      << config.to_toml_string() << std::flush;
-  config.save(dir / "config.resolved.toml");
-
-  const auto mode = restarted ? io::CsvWriter::Mode::Append : io::CsvWriter::Mode::Create;
-  io::CsvWriter csv(dir / "diagnostics.csv", diagnostics_columns(config, sim.num_membranes()), mode);
-  std::optional<io::CsvWriter> stretch;
-  if (sweep) {
-    stretch.emplace(dir / "stretch.csv", std::vector<std::string>{"force_pN", "axial_um", "transverse_um"}, mode);
-    out << "rbc_stretch: " << sweep->patch_nodes() << " nodes in the two contact patches, relaxation time "
-        << sweep->relaxation_time() << " s\n";
-  }
-  const long fields_every = config.get<int>("output.fields_every");
+  const int diagnostics_every = config.get<int>("output.diagnostics_every");
+  const int fields_every = config.get<int>("output.fields_every");
+  const int checkpoint_every = config.get<int>("output.checkpoint_every");
   int first_frame = 0;
   if (restarted && fields_every > 0) first_frame = static_cast<int>(sim.step() / fields_every) + 1;
-  io::XdmfWriter frames(dir, first_frame);
+
+  // 2. The output folder belongs to this run: locked while it runs; one that holds another run is refused unless
+  // this run continues it (--restart of its checkpoint) or replaces it (--overwrite).
+  const std::filesystem::path dir = options.out;
+  const bool in_place = restarted && same_folder(options.restart, dir);
+  if (in_place && options.overwrite)
+    throw InputError("--overwrite: would remove the run that --restart " + options.restart.string() +
+                     " continues (leave out --overwrite to continue it in " + dir.string() + ")");
+  if (restarted && !in_place && first_frame > 0)
+    throw InputError("--restart " + options.restart.string() + " with output.fields_every = " +
+                     std::to_string(fields_every) + ": the ParaView series continues in the checkpoint's own folder "
+                     "(use --out " + options.restart.parent_path().string() + ", or output.fields_every = 0)");
+  io::OutputFolder folder(dir);
+  if (const auto found = folder.run_files(); !found.empty() && !in_place && !options.overwrite) {
+    std::string names;
+    for (std::size_t i = 0; i < std::min<std::size_t>(found.size(), 3); ++i) names += (i ? ", " : "") + found[i];
+    if (found.size() > 3) names += ", ...";
+    throw InputError("--out " + dir.string() + " holds another run (" + names + "): choose another folder, " +
+                     (restarted ? std::string("restart from that run's own checkpoint")
+                                : "continue it with --restart " + (dir / "checkpoint.h5").string()) +
+                     ", or replace it with --overwrite");
+  }
+  // A restart continues the tables after the checkpoint (a damaged table is refused before anything is rewritten).
+  const auto columns = diagnostics_columns(config, sim.num_membranes());
+  const std::vector<std::string> stretch_columns{"force_pN", "axial_um", "transverse_um"};
+  std::optional<std::string> kept_diagnostics, kept_stretch;
+  if (in_place) {
+    io::CsvWriter::check_continuable(dir / "diagnostics.csv", columns);
+    kept_diagnostics =
+        rows_to_keep(dir / "diagnostics.csv", [&](long, double step) { return step <= double(sim.step()); });
+    if (sweep) {
+      io::CsvWriter::check_continuable(dir / "stretch.csv", stretch_columns);
+      kept_stretch = rows_to_keep(dir / "stretch.csv", [&](long row, double) { return row < long(sweep->current()); });
+    }
+  }
+
+  // 3. Output. A folder this run created is removed again if its first files cannot be written.
+  std::optional<io::XdmfWriter> frames_opt;
+  std::optional<io::CsvWriter> csv_opt, stretch;
+  try {
+    frames_opt.emplace(dir, first_frame);  // a restart reads back the frames before the checkpoint first
+    if (options.overwrite) folder.remove_run_files();
+    folder.remove_temporaries();  // of a writer that was killed
+    if (kept_diagnostics) io::AtomicFile::write(dir / "diagnostics.csv", *kept_diagnostics);
+    if (kept_stretch) io::AtomicFile::write(dir / "stretch.csv", *kept_stretch);
+
+    out << "# immerse " << IMMERSE_VERSION << ": " << options.file.string() << " -> " << dir.string() << "\n"
+        << "# resolved configuration (saved as config.resolved.toml)\n"
+        << config.to_toml_string() << std::flush;
+    config.save(dir / "config.resolved.toml");
+
+    const auto mode = restarted ? io::CsvWriter::Mode::Append : io::CsvWriter::Mode::Create;
+    csv_opt.emplace(dir / "diagnostics.csv", columns, mode);
+    if (sweep) stretch.emplace(dir / "stretch.csv", stretch_columns, mode);
+  } catch (const WriteError&) {
+    if (folder.created()) folder.remove_run_files();
+    throw;
+  }
+  io::CsvWriter& csv = *csv_opt;
+  io::XdmfWriter& frames = *frames_opt;
+  if (sweep)
+    out << "rbc_stretch: " << sweep->patch_nodes() << " nodes in the two contact patches, relaxation time "
+        << sweep->relaxation_time() << " s\n";
   StepRecord last;
   long checkpoint_step = -1;  // of the last checkpoint this run wrote
 
   std::vector<Callback> callbacks{
       // A row needs the record of its step: the step that turned out unstable has none.
-      {"diagnostics", config.get<int>("output.diagnostics_every"), !restarted, true,
+      {"diagnostics", diagnostics_every, !restarted, true,
        [&](const Simulation& s) {
          if (last.step == s.step()) csv.row(diagnostics_row(s, last));
        }},
       {"fields", fields_every, !restarted && fields_every > 0, fields_every > 0,
        [&](const Simulation& s) { write_frame(frames, s); }},
-      {"checkpoint", config.get<int>("output.checkpoint_every"), false, true,
+      {"checkpoint", checkpoint_every, false, true,
        [&](const Simulation& s) {
          io::Checkpoint ck = s.checkpoint();
          if (sweep) sweep->save(ck);
@@ -226,11 +305,8 @@ int run_command(const RunOptions& options, std::ostream& out, std::ostream& err)
   for (auto& c : callbacks)
     if (restarted) c.last_step = sim.step();  // the restart step's row, frame and checkpoint already exist
 
-  g_stop_signal = 0;
-  std::signal(SIGINT, on_signal);
-  std::signal(SIGTERM, on_signal);
   Progress progress(out, config.get<double>("time.end"), config.get<double>("output.log_seconds"));
-  auto log = [&](const std::string& msg) { out << "\n" << msg << "\n"; };
+  auto log = [&](const std::string& msg) { out << "\n" << msg << "\n" << std::flush; };
   int status = 0;
   long done = 0;
   double stepping = 0;  // wall time inside Simulation::advance, failed calls included
@@ -255,7 +331,7 @@ int run_command(const RunOptions& options, std::ostream& out, std::ostream& err)
       stepping += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     };
     try {
-      last = sim.advance(log);
+      last = sim.advance(log, [] { return g_stop_signal != 0; });
     } catch (...) {
       add_time();
       throw;
@@ -268,9 +344,19 @@ int run_command(const RunOptions& options, std::ostream& out, std::ostream& err)
     progress.update(sim, done);
     if (g_stop_signal) status = 4;
   };
+  // A full disk or a folder gone: no further write is attempted; what was written before is complete.
+  auto write_failed = [&](const WriteError& e) {
+    progress.finish();
+    err << "immerse: run stopped at step " << sim.step() << ", t = " << sim.time() << ": " << e.what() << " ("
+        << (checkpoint_step >= 0 ? "last checkpoint written: step " + std::to_string(checkpoint_step)
+                                 : std::string("no checkpoint written"))
+        << ")\n";
+    status = 5;
+  };
   try {
     for (auto& c : callbacks)
       if (c.at_start) c.run(sim, sim.step());
+    if (g_stop_signal) status = 4;
     while (status == 0 && !sim.finished() && !(sweep && sweep->done())) step_once();
     if (status == 0 && sweep && !sweep->done())
       out << "\nrbc_stretch: time.end reached during force " << sweep->current() + 1 << " of " << sweep->forces().size()
@@ -280,25 +366,22 @@ int run_command(const RunOptions& options, std::ostream& out, std::ostream& err)
     progress.finish();
     err << "immerse: run stopped: " << e.what() << "\n";
     status = 3;
+  } catch (const StopRequested&) {
+    status = 4;  // while a rejected step was to be retried: the state is the last accepted step's
   } catch (const WriteError& e) {
-    // A full disk or a folder gone: no further write is attempted; what was written before is complete.
-    progress.finish();
-    err << "immerse: run stopped at step " << sim.step() << ", t = " << sim.time() << ": " << e.what() << " ("
-        << (checkpoint_step >= 0 ? "last checkpoint written: step " + std::to_string(checkpoint_step)
-                                 : std::string("no checkpoint written"))
-        << ")\n";
-    status = 5;
+    write_failed(e);
   }
   progress.finish();
   // The last state is always saved, whatever ended the run (after an instability: the unstable state, for
-  // inspection), unless writing is what failed.
-  if (status != 5)
-    for (auto& c : callbacks)
-      if (c.at_end && c.last_step != sim.step()) c.run(sim, sim.step());
+  // inspection), unless writing is what failed; a failure to save it is a failed write too (exit 5).
+  if (status != 5) try {
+      for (auto& c : callbacks)
+        if (c.at_end && c.last_step != sim.step()) c.run(sim, sim.step());
+    } catch (const WriteError& e) {
+      write_failed(e);
+    }
   if (status == 4) err << "immerse: interrupted by signal " << g_stop_signal << " at step " << sim.step() << ", t = "
                        << sim.time() << "; checkpoint written to " << (dir / "checkpoint.h5").string() << "\n";
-  std::signal(SIGINT, SIG_DFL);
-  std::signal(SIGTERM, SIG_DFL);
 
   out << "done: " << sim.step() << " steps, t = " << sim.time();
   if (status == 0)

@@ -1,8 +1,10 @@
 #pragma once
-// `immerse run FILE.toml [--set key=value ...] [--out DIR] [--restart CHECKPOINT]`: reads and validates the whole
-// configuration and builds the run before anything is written; then prints and saves the resolved configuration,
-// runs the time loop with its scheduled callbacks (diagnostics.csv, ParaView frames, checkpoints, progress), and
-// stops cleanly on instability or SIGINT/SIGTERM with a last checkpoint and frame.
+// `immerse run FILE.toml [--set key=value ...] [--out DIR] [--restart CHECKPOINT] [--overwrite]`: reads and validates
+// the whole configuration and builds the run before anything is written; then prints and saves the resolved
+// configuration, runs the time loop with its scheduled callbacks (diagnostics.csv, ParaView frames, checkpoints,
+// progress), and stops cleanly on instability or SIGINT/SIGTERM/SIGHUP/SIGQUIT with a last checkpoint and frame.
+// The output folder is locked while the run writes, and a folder holding another run is refused unless continued or
+// replaced.
 #include <filesystem>
 #include <iosfwd>
 #include <string>
@@ -15,6 +17,7 @@ struct RunOptions {
   std::vector<std::string> sets;
   std::filesystem::path out = "out";
   std::filesystem::path restart;  ///< empty: start from t = 0
+  bool overwrite = false;         ///< remove the run files of another run in `out` first
 };
 
 /// Exit status: 0 done, 2 bad input (nothing written), 3 the run became unstable, 4 interrupted by a signal,

@@ -237,6 +237,16 @@ io::Config apply_scenario(const io::Config& config) {
     const double b = shear ? config.get<double>("scenario.kt_end") : end;
     throw InputError(step + " = " + num(a) + ": must be <= " + stop + " = " + num(b) + " (one step is longer than the run)");
   }
+  // A wall velocity on a periodic axis would be ignored: there is no wall to move.
+  for (const std::string axis : {"x", "y", "z"}) {
+    if (derived.get<std::string>("boundary." + axis) != "periodic") continue;
+    for (const std::string side : {"_lower_velocity", "_upper_velocity"}) {
+      const std::string key = "boundary." + axis + side;
+      if (const Vec3 v = derived.get<Vec3>(key); v.x != 0 || v.y != 0 || v.z != 0)
+        throw InputError(key + " = " + derived.value_text(key) + ": must be [0, 0, 0] when boundary." + axis +
+                         " = \"periodic\" (a wall velocity needs walls)");
+    }
+  }
   return derived;
 }
 

@@ -248,7 +248,8 @@ FluidState Simulation::initial_fluid_state() const {
 
 bool Simulation::finished() const { return time() >= config_.get<double>("time.end") * (1 - 1e-12); }
 
-StepRecord Simulation::advance(const std::function<void(const std::string&)>& log) {
+StepRecord Simulation::advance(const std::function<void(const std::string&)>& log,
+                               const std::function<bool()>& stop_requested) {
   const auto t0 = std::chrono::steady_clock::now();
   const double remaining = config_.get<double>("time.end") - time();
   StepRecord r;
@@ -257,7 +258,7 @@ StepRecord Simulation::advance(const std::function<void(const std::string&)>& lo
   where << "step " << step_ + 1 << ", t = " << time() << ": ";
   try {
     const auto acc = stepper_.advance(*integrator_, *op_, remaining,
-                                      [&](const std::string& msg) { log(where.str() + msg); });
+                                      [&](const std::string& msg) { log(where.str() + msg); }, stop_requested);
     r.stats = acc.stats;
     r.dt = acc.dt;
     r.rejected = acc.rejected;
@@ -290,6 +291,34 @@ void Simulation::check_stability(const StepRecord& r) const {
       throw SimulationError(s.str());
     }
   }
+  // The fluid everywhere in the box, also where no membrane samples it.
+  const FluidState& f = op_->fluid_state();
+  auto unstable_at = [&](const Array3& a, std::size_t n, const std::string& what, const std::string& symbol,
+                         const char* where) {
+    const std::size_t i = n % std::size_t(a.nx()), j = n / std::size_t(a.nx()) % std::size_t(a.ny()),
+                      k = n / (std::size_t(a.nx()) * std::size_t(a.ny()));
+    std::ostringstream s;
+    s.precision(10);
+    s << "unstable at step " << r.step << ", t = " << r.time << ": fluid " << what << " at " << where << " (" << i
+      << ", " << j << ", " << k << ") ";
+    const double v = a.values()[n];
+    if (std::isfinite(v))
+      s << "exceeds time.max_speed (runaway) (|" << symbol << "| = " << std::abs(v) << " m/s, bound " << vmax << ")";
+    else
+      s << "is not finite";
+    throw SimulationError(s.str());
+  };
+  for (int d = 0; d < 3; ++d) {
+    const auto& u = f.u[d].values();
+    for (std::size_t n = 0; n < u.size(); ++n)
+      if (!(std::abs(u[n]) <= vmax)) {
+        const std::string u_d = std::string("u_") + kAxes[d];
+        unstable_at(f.u[d], n, "velocity " + u_d, u_d, "face");
+      }
+  }
+  const auto& p = f.p.values();
+  for (std::size_t n = 0; n < p.size(); ++n)
+    if (!std::isfinite(p[n])) unstable_at(f.p, n, "pressure", "p", "cell");
 }
 
 io::Checkpoint Simulation::checkpoint() const {
@@ -348,39 +377,84 @@ void Simulation::restore(const io::Checkpoint& ck) {
     throw InputError("checkpoint was written by a different configuration: it has '" + la + "', this run has '" + lb +
                      "'");
   }
+  // Every entry is checked before it is used, so that a damaged checkpoint whose checksum was recomputed is
+  // refused by name instead of failing later in the run.
+  auto number = [&](const std::string& name, double v, bool ok, const std::string& allowed) {
+    if (ok) return v;
+    std::ostringstream s;
+    s << "= " << v << ": must be " << allowed;
+    ck.invalid(name, s.str());
+  };
+  auto count = [&](const std::string& name) {
+    const std::int64_t v = ck.get_int(name);
+    number(name, double(v), v >= 0, "an integer >= 0");
+    return v;
+  };
+  auto time_value = [&](const std::string& name) {
+    const double v = ck.get_double(name);
+    return number(name, v, std::isfinite(v) && v >= 0, "a finite number >= 0");
+  };
+  auto array = [&](const std::string& name, std::size_t size) -> const std::vector<double>& {
+    const auto& values = ck.array(name);
+    if (values.size() != size)
+      ck.invalid(name, "has " + std::to_string(values.size()) + " values, this configuration needs " +
+                           std::to_string(size));
+    for (std::size_t i = 0; i < values.size(); ++i)
+      if (!std::isfinite(values[i]))
+        ck.invalid(name, "has a value that is not finite (index " + std::to_string(i) + ")");
+    return values;
+  };
   FluidState f = fluid_.initial_state();
   for (int d = 0; d < 3; ++d) {
-    f.u[d].values() = ck.array("fluid.u" + std::to_string(d));
-    f.adv[d].values() = ck.array("fluid.adv" + std::to_string(d));
+    const std::size_t n = f.u[d].values().size();
+    f.u[d].values() = array("fluid.u" + std::to_string(d), n);
+    f.adv[d].values() = array("fluid.adv" + std::to_string(d), n);
   }
-  f.p.values() = ck.array("fluid.p");
-  f.dt_prev = ck.get_double("fluid.dt_prev");
+  f.p.values() = array("fluid.p", f.p.values().size());
+  f.dt_prev = time_value("fluid.dt_prev");
   // Checkpoints written before fluid.pressure have no p^{n-3/2}: an extrapolating run then lags for one step.
   if (ck.has("fluid.p_prev")) {
-    f.p_prev.values() = ck.array("fluid.p_prev");
-    f.dt_prev2 = ck.get_double("fluid.dt_prev2");
+    f.p_prev.values() = array("fluid.p_prev", f.p_prev.values().size());
+    f.dt_prev2 = time_value("fluid.dt_prev2");
   }
-  f.step = ck.get_int("fluid.step");
-  f.time = ck.get_double("fluid.time");
+  f.step = count("fluid.step");
+  f.time = time_value("fluid.time");
   std::vector<std::vector<Vec3>> X(num_membranes());
+  std::size_t unknowns = 0;
   for (std::size_t m = 0; m < num_membranes(); ++m) {
     const auto& R = references_[m];
     if (ck.array(membrane_name(m) + ".reference") != std::vector<double>(&R[0].x, &R[0].x + 3 * R.size()))
       throw InputError("checkpoint: the reference state of " + membrane_name(m) +
                        " differs from the one this configuration builds (was its mesh file changed?)");
-    const auto& a3 = ck.array(membrane_name(m) + ".positions");
+    const auto& a3 = array(membrane_name(m) + ".positions", 3 * R.size());
     X[m].resize(a3.size() / 3);
     for (std::size_t i = 0; i < X[m].size(); ++i) X[m][i] = {a3[3 * i], a3[3 * i + 1], a3[3 * i + 2]};
+    unknowns += a3.size();
+  }
+  const std::string previous = "integrator.previous_positions";
+  const auto& prev_X = array(previous, ck.array(previous).empty() ? 0 : unknowns);
+  const double prev_dt = time_value("integrator.previous_dt");
+  // Checkpoints written before the initial-guess recurrence have no guess errors: it then starts afresh.
+  const std::string errors = "integrator.guess_errors";
+  const std::vector<double> guess_errors =
+      ck.has(errors) ? array(errors, ck.array(errors).size()) : std::vector<double>{};
+  const double nominal = config_.get<double>("time.dt"), dt = ck.get_double("stepper.dt");
+  number("stepper.dt", dt, std::isfinite(dt) && dt > 0 && dt <= nominal, "in (0, time.dt]");
+  const std::int64_t successes = count("stepper.successes");
+  const std::int64_t step = count("step");
+  const double end = config_.get<double>("time.end");
+  if (f.time >= end * (1 - 1e-12)) {
+    std::ostringstream s;
+    s << "time.end = " << end << ": must be later than the time of the checkpoint " << ck.source() << ", t = "
+      << f.time << " (nothing left to run)";
+    throw InputError(s.str());
   }
   std::vector<const ElasticMembrane*> ms;
   for (auto& m : membranes_) ms.push_back(m.get());
   op_ = std::make_unique<ImmersedBoundaryOperator>(fluid_, coupler_, ms, X, std::move(f));
-  // Checkpoints written before the initial-guess recurrence have no guess errors: it then starts afresh.
-  const std::string errors = "integrator.guess_errors";
-  integrator_->set_history(ck.array("integrator.previous_positions"), ck.get_double("integrator.previous_dt"),
-                           ck.has(errors) ? ck.array(errors) : std::vector<double>{});
-  stepper_.set_state(ck.get_double("stepper.dt"), static_cast<int>(ck.get_int("stepper.successes")));
-  step_ = ck.get_int("step");
+  integrator_->set_history(prev_X, prev_dt, guess_errors);
+  stepper_.set_state(dt, static_cast<int>(successes));
+  step_ = step;
 }
 
 }  // namespace immerse

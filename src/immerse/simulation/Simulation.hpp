@@ -36,7 +36,9 @@ class Simulation {
 
   /// Advances one accepted step (with step halving on failed solves, reported through `log`). Throws
   /// SimulationError naming step, time, membrane and quantity when the run becomes unstable.
-  StepRecord advance(const std::function<void(const std::string&)>& log);
+  /// `stop_requested` is asked after each rejected attempt (StopRequested is thrown when it returns true).
+  StepRecord advance(const std::function<void(const std::string&)>& log,
+                     const std::function<bool()>& stop_requested = {});
   bool finished() const;
 
   long step() const { return step_; }

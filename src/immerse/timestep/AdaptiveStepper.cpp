@@ -17,7 +17,8 @@ AdaptiveStepper::AdaptiveStepper(double dt_nominal, double dt_min, int grow_afte
 
 AdaptiveStepper::Accepted AdaptiveStepper::advance(MembraneIntegrator& integrator, CoupledOperator& op,
                                                    double max_dt,
-                                                   const std::function<void(const std::string&)>& log) {
+                                                   const std::function<void(const std::string&)>& log,
+                                                   const std::function<bool()>& stop_requested) {
   const std::size_t solves0 = op.fluid_solves();
   int rejected = 0;
   for (;;) {
@@ -40,6 +41,7 @@ AdaptiveStepper::Accepted AdaptiveStepper::advance(MembraneIntegrator& integrato
       s << "; the halved step " << dt_ << " is below time.dt_min = " << dt_min_;
       throw SimulationError(s.str());
     }
+    if (stop_requested && stop_requested()) throw StopRequested(s.str() + "; not retried: a stop was requested");
     s << "; retrying with dt = " << dt_;
     log(s.str());
   }

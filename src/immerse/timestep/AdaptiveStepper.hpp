@@ -20,9 +20,11 @@ class AdaptiveStepper {
     int rejected;     ///< attempts rejected before it
   };
   /// Advances one accepted step of at most max_dt (the caller's clamp to the end time). Each rejection is reported
-  /// through `log` with its reason and the new step.
+  /// through `log` with its reason and the new step; when `stop_requested` then returns true, StopRequested is
+  /// thrown instead of retrying.
   Accepted advance(MembraneIntegrator& integrator, CoupledOperator& op, double max_dt,
-                   const std::function<void(const std::string&)>& log);
+                   const std::function<void(const std::string&)>& log,
+                   const std::function<bool()>& stop_requested = {});
 
   double dt() const { return dt_; }
   double nominal_dt() const { return nominal_; }

@@ -11,6 +11,9 @@ PetscSession::PetscSession() {
   if (PetscInitializeNoArguments() != 0) throw std::runtime_error("PETSc failed to initialize");
   // Errors come back as codes and become exceptions; nothing is printed by PETSc itself.
   PetscPushErrorHandler(PetscReturnErrorHandler, nullptr);
+  // PETSc's signal handler prints a crash report and aborts MPI on SIGPIPE, SIGHUP, SIGTERM...: the default
+  // dispositions come back, and the program sets its own where it needs them.
+  PetscPopSignalHandler();
 }
 
 PetscSession::~PetscSession() {
