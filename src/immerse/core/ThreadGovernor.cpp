@@ -97,13 +97,17 @@ ThreadGovernor ThreadGovernor::from_environment() {
   return cpus > 1 ? adaptive(cpus) : ThreadGovernor();
 }
 
+std::size_t ThreadGovernor::initial_samples(int i) const {
+  return i == 0 ? count_[0] : count_[1] - std::min(count_[1], kWarmup);
+}
+
 int ThreadGovernor::choose() {
   if (!adaptive_) return omp_get_max_threads();
   int i = current_;
-  if (seen_ < kWarmup || estimate_[1] == 0)
+  if (seen_ < kWarmup)
     i = 1;
-  else if (estimate_[0] == 0)
-    i = 0;
+  else if (initial_samples(1) < kInitialSamples || initial_samples(0) < kInitialSamples)
+    i = initial_samples(1) <= initial_samples(0) ? 1 : 0;  // alternate until both have their samples
   else if (seen_ >= next_probe_)
     i = 1 - current_;
   running_ = i;
@@ -120,9 +124,11 @@ void ThreadGovernor::record(double seconds) {
   ++seen_;
   if (seen_ <= kWarmup) return;
   double& est = estimate_[running_];
-  if (est == 0) {  // the first measurement of each count: then run on the cheaper one
-    est = seconds;
-    if (estimate_[0] > 0 && estimate_[1] > 0) {
+  if (const std::size_t n = initial_samples(running_); n <= kInitialSamples) {
+    // The first measurements of each count, averaged (one alone is at the mercy of the scheduler); then run on
+    // the cheaper.
+    est += (seconds - est) / static_cast<double>(n);
+    if (initial_samples(0) >= kInitialSamples && initial_samples(1) >= kInitialSamples) {
       current_ = estimate_[0] <= estimate_[1] ? 0 : 1;
       at_decision_ = estimate_[current_];
       next_probe_ = seen_ + probe_interval();

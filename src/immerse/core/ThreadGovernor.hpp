@@ -52,6 +52,7 @@ class ThreadGovernor {
 
   // Tuning, exposed for the tests.
   static constexpr std::size_t kWarmup = 2;          ///< first evaluations not timed (first touch of the buffers)
+  static constexpr std::size_t kInitialSamples = 2; ///< evaluations of each count averaged before the first choice
   static constexpr std::size_t kFirstInterval = 8;   ///< evaluations between probes after a switch
   static constexpr std::size_t kMaxInterval = 1024;  ///< longest interval between probes
   static constexpr double kSwitch = 0.9;             ///< a probe wins when it costs less than this times the estimate
@@ -63,6 +64,7 @@ class ThreadGovernor {
   int index(int threads) const { return threads == 1 ? 0 : 1; }
   int threads_of(int i) const { return i == 0 ? 1 : max_; }
   std::size_t probe_interval() const;
+  std::size_t initial_samples(int i) const;  ///< timed evaluations of count index i so far
 
   bool adaptive_ = false;
   int max_ = 1;
