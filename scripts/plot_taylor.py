@@ -6,7 +6,7 @@ Usage: /usr/bin/python3 scripts/plot_taylor.py RUN_DIR [RUN_DIR ...] [-o PNG] [-
 Runs of the shear scenarios capsule_shear (Fig. 7), oblate_shear (Figs. 8-9) and bending_shear (Fig. 11). From each
 run's config.resolved.toml: the shear rate k = (boundary.z_upper_velocity[0] - boundary.z_lower_velocity[0]) /
 domain.Lz and the legend (scenario.G; scenario.aspect_ratio = b/a for oblate_shear; scenario.kappa_B_hat for
-bending_shear). Each capsule_shear run gets the small-deformation theory D = 25G/4 (docs/theory/numerics-notes.md; initially
+bending_shear). Each capsule_shear run gets the small-deformation theory D = 25G/4 (docs/theory/conventions.md; initially
 spherical neo-Hookean capsule without bending, viscosity ratio 1) as a dashed line of its colour; the theory does
 not apply to oblate or bending capsules and the paper draws none there. When the runs differ in kappa_B_hat, the
 line width grows with kappa_B_hat, as in Fig. 11. --panel-per-G draws one panel per value of G (Fig. 11 a, b).

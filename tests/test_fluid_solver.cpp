@@ -391,7 +391,7 @@ TEST(MacOperators, HomogeneousLaplacianIsSymmetricOnEveryLayout) {
   }
 }
 
-// The eigen-systems of docs/theory/numerics-notes.md: a product of the tabulated eigenvectors is reproduced by the solver.
+// The eigen-systems of docs/theory/conventions.md: a product of the tabulated eigenvectors is reproduced by the solver.
 TEST(FastSolver, ReproducesTheTabulatedEigenvectors) {
   const Grid g({8, 6, 10}, {0.8, 0.6, 1.0}, {W, P, W});
   const double h = g.h();

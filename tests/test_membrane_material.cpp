@@ -68,7 +68,7 @@ TEST(MembraneMaterial, SmallStrainAreaModuli) {
 }
 
 // The neo-Hookean Laplace pressure of an inflated sphere, dp a / Gs = 2 tau / (lambda Gs), peaks at
-// lambda = 7^(1/6) with the value 1.239463 (docs/theory/numerics-notes.md).
+// lambda = 7^(1/6) with the value 1.239463 (docs/theory/conventions.md).
 TEST(MembraneMaterial, NeoHookeanLaplacePeak) {
   const double Es = 3.0, Gs = Es / 3;
   const double l = std::pow(7.0, 1.0 / 6);

@@ -1,6 +1,6 @@
 #pragma once
 // Exact solutions of the incompressible Navier–Stokes equations (1)–(3) used to verify the fluid solver
-// (formulas from docs/theory/numerics-notes.md, "Exact flows used by the fluid studies"). ν = μ/ρ.
+// (formulas from docs/theory/conventions.md, "Exact flows used by the fluid studies"). ν = μ/ρ.
 #include <array>
 
 #include "immerse/core/Vec3.hpp"

@@ -3,7 +3,7 @@
 // problems of (9) and the Poisson problem (11) are solved by fast transforms; we use FFTW instead of FISHPACK).
 //
 // The 7-point Laplacian is separable, and on each axis one real transform diagonalizes its 3-point part
-// (docs/theory/numerics-notes.md, "MAC grid and fast transforms"), with N cells of size h on that axis:
+// (docs/theory/conventions.md, "MAC grid and fast transforms"), with N cells of size h on that axis:
 //   periodic axis                              R2HC / HC2R, N points          λ = −(4/h²) sin²(π k/N)
 //   wall axis, face-normal velocity            RODFT00 on the N−1 interior    λ = −(4/h²) sin²(π k/2N), k = 1..N−1
 //   wall axis, cell-centred velocity (ghost)   RODFT10 / RODFT01, N           λ = −(4/h²) sin²(π k/2N), k = 1..N

@@ -30,7 +30,7 @@
 // choice (docs/time-integration.md, "Anderson acceleration").
 //
 // Positions are measured in the operator's length scale inside the solver, so that eq. (37)'s perturbation is
-// relative to the geometry whatever the physical units (docs/theory/numerics-notes.md, "The implicit step").
+// relative to the geometry whatever the physical units (docs/theory/conventions.md, "The implicit step").
 // Every PETSc option stays overridable through SolverSettings::petsc_options.
 #include <petscsnes.h>
 

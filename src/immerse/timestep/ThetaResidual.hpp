@@ -6,7 +6,7 @@
 // where u^{n+1}(X) is one fluid step from the committed state driven by
 //   F^{n+1/2} = (1 - theta) S(X^n) f(X^n) + theta S(X) f(X).
 // theta = 1/2 is the trapezoidal rule (29) of the paper; the force is then centred in time as well, which is what
-// makes the coupled step second order for both X and u (Table 1; docs/theory/numerics-notes.md). theta = 1 is backward Euler
+// makes the coupled step second order for both X and u (Table 1; docs/theory/conventions.md). theta = 1 is backward Euler
 // (L-stable: no ringing of stiff membrane modes at large dt). g is a pure function of X: the committed state is
 // never changed, so GMRES may evaluate it as often as it needs (each evaluation is one fluid solve).
 #include <span>

@@ -26,7 +26,7 @@ std::vector<Check> delta_moments(bool quick) {
   std::uniform_real_distribution<double> shift(-3.0, 3.0);
   const int shifts = quick ? 2000 : 200000;
 
-  // Point values quoted in docs/theory/numerics-notes.md, "Discrete delta functions".
+  // Point values quoted in docs/theory/conventions.md, "Discrete delta functions".
   const RomaPeskin3 r3;
   const Peskin4 p4;
   const double point_error =
