@@ -83,7 +83,8 @@ std::optional<std::string> rows_to_keep(const std::filesystem::path& path,
 
 // Signal dispositions while a run is on: SIGINT, SIGTERM, SIGHUP and SIGQUIT ask for a stop (checkpoint, exit 4);
 // SIGPIPE is ignored, so that a closed standard output (`immerse run ... | head`) only silences the log. The
-// previous dispositions come back at the end.
+// previous dispositions come back at the end, unless a stop was asked for: then further stop signals (a storm of
+// SIGTERM from a scheduler) keep only setting the flag until the program has exited with status 4.
 class StopSignals {
  public:
   StopSignals() {
@@ -97,6 +98,7 @@ class StopSignals {
     }
   }
   ~StopSignals() {
+    if (g_stop_signal != 0) return;
     for (std::size_t i = 0; i < kSignals.size(); ++i) sigaction(kSignals[i], &saved_[i], nullptr);
   }
   StopSignals(const StopSignals&) = delete;
