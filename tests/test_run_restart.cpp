@@ -112,3 +112,41 @@ TEST(RestartSweep, ForceSweepContinuesBitwiseFromAMidSweepCheckpoint) {
   EXPECT_EQ(without_wall_clock(read_csv(dir / "whole" / "diagnostics.csv")),
             without_wall_clock(read_csv(dir / "split" / "diagnostics.csv")));
 }
+
+// A restart into another (new) folder branches the run: that folder holds a new series of rows, frames and
+// checkpoints beginning at the checkpoint's step, with the same states as the uninterrupted run; the folder of
+// the checkpoint is left as it was. The end time and the output schedule may differ from the first run's.
+TEST(RestartBranch, ANewFolderStartsANewSeriesAtTheCheckpointStep) {
+  ScratchDir dir("restart");
+  auto sets = [](int steps, int fields_every) {
+    auto s = small_membrane_sets(steps);
+    s.push_back("output.fields_every=" + std::to_string(fields_every));
+    return s;
+  };
+  ASSERT_EQ(run(dir / "whole", sets(kSteps, 1)), 0);
+  ASSERT_EQ(run(dir / "first", sets(kSteps / 2, 2)), 0);
+  const std::string first_rows = read_text(dir / "first" / "diagnostics.csv");
+  const auto first_frames = frame_files(dir / "first");
+  ASSERT_EQ(run(dir / "branch", sets(kSteps, 1), dir / "first" / "checkpoint.h5"), 0);
+
+  EXPECT_EQ(read_text(dir / "first" / "diagnostics.csv"), first_rows);
+  EXPECT_EQ(frame_files(dir / "first"), first_frames);
+  const auto whole = io::Checkpoint::read(dir / "whole" / "checkpoint.h5");
+  const auto branch = io::Checkpoint::read(dir / "branch" / "checkpoint.h5");
+  EXPECT_TRUE(whole == branch) << "checksums " << whole.checksum() << " vs " << branch.checksum();
+
+  // Rows of steps kSteps/2 .. kSteps: the branch point, then the same rows as the whole run (apart from the
+  // branch point's solver columns, which describe no step of this run).
+  const auto rows = without_wall_clock(read_csv(dir / "branch" / "diagnostics.csv"));
+  const auto all = without_wall_clock(read_csv(dir / "whole" / "diagnostics.csv"));
+  ASSERT_EQ(rows.size(), std::size_t(kSteps / 2 + 2));
+  EXPECT_EQ(rows[0], all[0]);
+  EXPECT_EQ(std::stol(rows[1][0]), kSteps / 2);
+  EXPECT_EQ(rows[1][1], all[kSteps / 2 + 1][1]);  // time of the branch point
+  for (std::size_t r = 2; r < rows.size(); ++r) EXPECT_EQ(rows[r], all[kSteps / 2 + r]) << "row " << r;
+  // One frame per step from the branch point: frames 0 .. kSteps/2, the first at the checkpoint's time.
+  EXPECT_EQ(frame_files(dir / "branch").size(), std::size_t(kSteps / 2 + 1));
+  const std::string series = read_text(dir / "branch" / "membranes.xdmf");
+  EXPECT_NE(series.find("fields_000000.h5"), std::string::npos);
+  EXPECT_EQ(series.find("fields_00000" + std::to_string(kSteps / 2 + 1) + ".h5"), std::string::npos);
+}

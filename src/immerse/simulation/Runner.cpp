@@ -220,20 +220,17 @@ int run_command(const RunOptions& options, std::ostream& out, std::ostream& err)
   const int diagnostics_every = config.get<int>("output.diagnostics_every");
   const int fields_every = config.get<int>("output.fields_every");
   const int checkpoint_every = config.get<int>("output.checkpoint_every");
-  int first_frame = 0;
-  if (restarted && fields_every > 0) first_frame = static_cast<int>(sim.step() / fields_every) + 1;
 
   // 2. The output folder belongs to this run: locked while it runs; one that holds another run is refused unless
-  // this run continues it (--restart of its checkpoint) or replaces it (--overwrite).
+  // this run continues it (--restart of its checkpoint) or replaces it (--overwrite). A restart into another
+  // folder branches the run: a new series of rows, frames and checkpoints that begins at the checkpoint's step.
   const std::filesystem::path dir = options.out;
   const bool in_place = restarted && same_folder(options.restart, dir);
   if (in_place && options.overwrite)
     throw InputError("--overwrite: would remove the run that --restart " + options.restart.string() +
                      " continues (leave out --overwrite to continue it in " + dir.string() + ")");
-  if (restarted && !in_place && first_frame > 0)
-    throw InputError("--restart " + options.restart.string() + " with output.fields_every = " +
-                     std::to_string(fields_every) + ": the ParaView series continues in the checkpoint's own folder "
-                     "(use --out " + options.restart.parent_path().string() + ", or output.fields_every = 0)");
+  int first_frame = 0;
+  if (in_place && fields_every > 0) first_frame = static_cast<int>(sim.step() / fields_every) + 1;
   io::OutputFolder folder(dir);
   if (const auto found = folder.run_files(); !found.empty() && !in_place && !options.overwrite) {
     std::string names;
@@ -273,7 +270,7 @@ int run_command(const RunOptions& options, std::ostream& out, std::ostream& err)
         << config.to_toml_string() << std::flush;
     config.save(dir / "config.resolved.toml");
 
-    const auto mode = restarted ? io::CsvWriter::Mode::Append : io::CsvWriter::Mode::Create;
+    const auto mode = in_place ? io::CsvWriter::Mode::Append : io::CsvWriter::Mode::Create;
     csv_opt.emplace(dir / "diagnostics.csv", columns, mode);
     if (sweep) stretch.emplace(dir / "stretch.csv", stretch_columns, mode);
   } catch (const WriteError&) {
@@ -285,16 +282,18 @@ int run_command(const RunOptions& options, std::ostream& out, std::ostream& err)
   if (sweep)
     out << "rbc_stretch: " << sweep->patch_nodes() << " nodes in the two contact patches, relaxation time "
         << sweep->relaxation_time() << " s\n";
-  StepRecord last;
+  StepRecord last;  // the branch point of a restart into another folder is the first row of its series
+  last.step = sim.step();
+  last.time = sim.time();
   long checkpoint_step = -1;  // of the last checkpoint this run wrote
 
   std::vector<Callback> callbacks{
       // A row needs the record of its step: the step that turned out unstable has none.
-      {"diagnostics", diagnostics_every, !restarted, true,
+      {"diagnostics", diagnostics_every, !in_place, true,
        [&](const Simulation& s) {
          if (last.step == s.step()) csv.row(diagnostics_row(s, last));
        }},
-      {"fields", fields_every, !restarted && fields_every > 0, fields_every > 0,
+      {"fields", fields_every, !in_place && fields_every > 0, fields_every > 0,
        [&](const Simulation& s) { write_frame(frames, s); }},
       {"checkpoint", checkpoint_every, false, true,
        [&](const Simulation& s) {
@@ -304,8 +303,8 @@ int run_command(const RunOptions& options, std::ostream& out, std::ostream& err)
          checkpoint_step = s.step();
        }},
   };
-  for (auto& c : callbacks)
-    if (restarted) c.last_step = sim.step();  // the restart step's row, frame and checkpoint already exist
+  for (auto& c : callbacks)  // the restart step's row, frame and checkpoint exist (in place) or are not needed
+    if (restarted && (in_place || !c.at_start)) c.last_step = sim.step();
 
   Progress progress(out, config.get<double>("time.end"), config.get<double>("output.log_seconds"));
   auto log = [&](const std::string& msg) { out << "\n" << msg << "\n" << std::flush; };

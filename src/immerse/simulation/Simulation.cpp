@@ -354,28 +354,26 @@ io::Checkpoint Simulation::checkpoint() const {
 }
 
 void Simulation::restore(const io::Checkpoint& ck) {
-  // The checkpoint's configuration must be this one, up to the end time and the output schedule.
+  // The checkpoint's configuration must be this one, up to the keys a continued or branched run may change.
   const io::Config theirs = config_.schema().parse_string(ck.get_string("config"), "checkpoint");
-  // Compare the resolved TOML texts key by key, leaving out the [output] table and time.end.
-  auto strip = [](const std::string& toml) {
-    std::istringstream in(toml);
-    std::string line, out, section;
-    while (std::getline(in, line)) {
-      if (line.empty() || line[0] == '#') continue;
-      if (line[0] == '[') section = line;
-      if (section == "[output]" || (section == "[time]" && line.rfind("end ", 0) == 0)) continue;
-      out += section + " " + line + "\n";
-    }
-    return out;
+  const auto may_change = [](const std::string& key) {
+    return key == "time.end" || key == "scenario.kt_end" || key.starts_with("output.") || key.starts_with("solver.");
   };
-  const std::string a = strip(theirs.to_toml_string()), b = strip(config_.to_toml_string());
-  if (a != b) {
-    std::istringstream ia(a), ib(b);
-    std::string la, lb;
-    while (std::getline(ia, la) && std::getline(ib, lb) && la == lb) {
-    }
-    throw InputError("checkpoint was written by a different configuration: it has '" + la + "', this run has '" + lb +
-                     "'");
+  const auto differ = [&](const std::string& key, const std::string& was, const std::string& is) {
+    throw InputError(key + " = " + is + ": the checkpoint " + ck.source() + " was written with " + key + " = " + was +
+                     " (on restart only time.end, scenario.kt_end, [output] and [solver] keys may change)");
+  };
+  for (const auto& k : config_.schema().keys())
+    if (!may_change(k.key) && theirs.value_text(k.key) != config_.value_text(k.key))
+      differ(k.key, theirs.value_text(k.key), config_.value_text(k.key));
+  for (const auto& t : config_.schema().table_arrays()) {
+    if (theirs.count(t.name) != config_.count(t.name))
+      differ("[[" + t.name + "]] count", std::to_string(theirs.count(t.name)), std::to_string(config_.count(t.name)));
+    for (std::size_t i = 0; i < config_.count(t.name); ++i)
+      for (const auto& k : config_.entry(t.name, i).schema().keys()) {
+        const std::string was = theirs.entry(t.name, i).value_text(k.key), is = config_.entry(t.name, i).value_text(k.key);
+        if (was != is) differ(t.name + "[" + std::to_string(i) + "]." + k.key, was, is);
+      }
   }
   // Every entry is checked before it is used, so that a damaged checkpoint whose checksum was recomputed is
   // refused by name instead of failing later in the run.
