@@ -9,6 +9,7 @@
 #include <iostream>
 
 #include "immerse/core/Error.hpp"
+#include "immerse/io/Provenance.hpp"
 #include "immerse/simulation/Runner.hpp"
 #include "immerse/timestep/PetscSession.hpp"
 #include "immerse/verify/Runner.hpp"
@@ -68,6 +69,8 @@ int main(int argc, char** argv) {
                                   "continues that run's files)");
   run->add_flag("--overwrite", run_opts.overwrite,
                 "Replace the run already in the --out folder (its files are removed first; other files are kept)");
+  run->add_flag("--verbose", run_opts.verbose,
+                "Also print the whole resolved configuration (always saved as OUT/config.resolved.toml)");
   run->add_flag("--help-config", help_config, "List every configuration key with its default, range and meaning");
   auto* scenarios = app.add_subcommand("scenarios", "List the bundled scenario files");
 
@@ -79,6 +82,7 @@ int main(int argc, char** argv) {
 
   try {
     app.parse(argc, argv);
+    run_opts.command_line = immerse::io::Provenance::quote_command_line(argc, argv);
   } catch (const CLI::ParseError& e) {
     if (e.get_exit_code() == 0) return app.exit(e);  // --help, --version
     std::cerr << "immerse: error: " << e.what() << " (see immerse --help)\n";

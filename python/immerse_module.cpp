@@ -224,6 +224,15 @@ line's --set: a dict {"scenario.G": 0.1, ...} or a list of "KEY=VALUE" strings. 
       .def("run", &PySimulation::run, py::arg("steps") = py::none(), py::arg("until") = py::none(),
            "Steps until `steps` more steps, time `until` or time.end; returns {column: numpy array}.")
       .def_property_readonly("columns", &PySimulation::columns)
+      .def_property_readonly(
+          "units",
+          [](const PySimulation& s) {
+            py::dict units;
+            for (const auto& c : diagnostics_column_info(s.sim().config(), s.sim().num_membranes()))
+              units[py::str(c.name)] = c.unit;
+            return units;
+          },
+          "{column: unit} of the diagnostics (UDUNITS form; \"1\" for a pure number), as diagnostics.columns.csv.")
       .def_property_readonly("time", [](const PySimulation& s) { return s.sim().time(); })
       .def_property_readonly("steps", [](const PySimulation& s) { return s.sim().step(); })
       .def_property_readonly("finished", [](const PySimulation& s) { return s.sim().finished(); })

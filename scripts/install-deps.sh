@@ -5,7 +5,7 @@ pkgs=(cmake g++ make pkg-config
       libfftw3-dev libhdf5-dev libtomlplusplus-dev libcli11-dev
       petsc-dev
       libgtest-dev libgmock-dev libbenchmark-dev
-      python3 python3-matplotlib python3-numpy python3-h5py python3-dev pybind11-dev
+      python3 python3-matplotlib python3-numpy python3-h5py python3-meshio python3-dev pybind11-dev
       mkdocs mkdocs-material  # scripts/build-docs.sh (the documentation site, test docs.site)
       clang libclang-rt-14-dev libomp-14-dev)  # the last three: scripts/fuzz.sh (libFuzzer, cmake --preset fuzz)
 missing=()

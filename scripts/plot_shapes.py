@@ -48,23 +48,28 @@ def frame_time(path):
 
 
 def read_membranes(path, only):
-    """(time, [(index, nodes [N,3], linear triangles [4T,3]), ...]) of the membranes in one frame."""
+    """(time, [(index, nodes [N,3], linear triangles [4T,3]), ...]) of the membranes in one frame.
+
+    /membranes holds all membranes in one surface: membrane k owns nodes node_offsets[k] .. node_offsets[k+1]-1
+    and the elements whose membrane_id is k."""
     with h5py.File(path, "r") as f:
         time = float(f.attrs["time"])
-        if "membranes" not in f:
+        if "membranes" not in f or "node_offsets" not in f["membranes"]:
             pc.fail(f"{path} has no membranes")
-        names = sorted(f["membranes"].keys(), key=lambda n: int(n.removeprefix("membrane")))
-        indices = [int(n.removeprefix("membrane")) for n in names]
-        if only is not None and only not in indices:
-            pc.fail(f"--membrane {only}: {path} has membranes {indices[0]} ... {indices[-1]}")
+        g = f["membranes"]
+        offsets, ids = g["node_offsets"][()], g["membrane_id"][()]
+        nodes_all, conn_all = g["nodes"][()], g["connectivity"][()]
+        count = len(offsets) - 1
+        if only is not None and not 0 <= only < count:
+            pc.fail(f"--membrane {only}: {path} has membranes 0 ... {count - 1}")
+        if conn_all.ndim != 2 or conn_all.shape[1] != 6:
+            pc.fail(f"{path}: connectivity has shape {conn_all.shape}, expected [T, 6] (6-node triangles)")
         out = []
-        for m, name in zip(indices, names):
+        for m in range(count):
             if only is not None and m != only:
                 continue
-            nodes = f["membranes"][name]["nodes"][()]
-            conn = f["membranes"][name]["connectivity"][()]
-            if conn.ndim != 2 or conn.shape[1] != 6:
-                pc.fail(f"{path}: {name} connectivity has shape {conn.shape}, expected [T, 6] (6-node triangles)")
+            nodes = nodes_all[offsets[m]:offsets[m + 1]]
+            conn = conn_all[ids == m] - offsets[m]
             out.append((m, nodes, conn[:, SUB_TRIANGLES].reshape(-1, 3)))
     return time, out
 

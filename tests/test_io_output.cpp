@@ -275,7 +275,7 @@ TEST(XdmfWriter, TwoFramesReadBackExactlyAndXdmfReferencesThem) {
     const double shift = 0.125 * frame;
     const Surface a = surface(1, shift), b = surface(2, shift);
     const SurfaceFrame sa{"capsule0", a.nodes, a.tris, {{"force", a.force}}, {{"tension", a.tension}}};
-    const SurfaceFrame sb{"cell1", b.nodes, b.tris, {{"force", b.force}, {"velocity", b.nodes}}, {}};
+    const SurfaceFrame sb{"cell1", b.nodes, b.tris, {{"force", b.force}}, {{"tension", b.tension}}};
     const std::vector<SurfaceFrame> surfaces{sa, sb};
     const FaceField u = sample_faces(g, [&](const Vec3& x) { return Vec3{x.y * (0.75 - x.y) + shift, x.z, x.x}; });
     Array3 p(4, 3, 5);
@@ -285,22 +285,34 @@ TEST(XdmfWriter, TwoFramesReadBackExactlyAndXdmfReferencesThem) {
     const fs::path h5 = w.write_frame(0.5 * frame + 0.1, surfaces, &fluid);
     EXPECT_EQ(h5, dir / XdmfWriter::frame_file_name(frame));
 
-    // Read back with the HDF5 API: bitwise equal to what was given.
+    // Read back with the HDF5 API: bitwise equal to what was given, the second membrane's nodes after the first's.
     hdf5::Handle f = hdf5::open_file_readonly(h5);
     ASSERT_TRUE(f.valid());
     std::vector<double> v;
     std::vector<std::int32_t> conn;
     std::vector<hsize_t> dims;
-    ASSERT_TRUE(hdf5::read_doubles(f.get(), "/membranes/cell1/nodes", v, dims));
-    EXPECT_EQ(dims, (std::vector<hsize_t>{9, 3}));
+    const std::size_t na = a.nodes.size();
+    ASSERT_TRUE(hdf5::read_doubles(f.get(), "/membranes/nodes", v, dims));
+    EXPECT_EQ(dims, (std::vector<hsize_t>{na + 9, 3}));
     for (std::size_t i = 0; i < b.nodes.size(); ++i)
-      for (int d = 0; d < 3; ++d) EXPECT_EQ(v[3 * i + d], b.nodes[i][d]);
-    ASSERT_TRUE(hdf5::read_int32(f.get(), "/membranes/cell1/connectivity", conn, dims));
-    EXPECT_EQ(dims, (std::vector<hsize_t>{2, 6}));
-    EXPECT_EQ(conn, (std::vector<std::int32_t>{0, 1, 2, 3, 4, 5, 1, 6, 2, 7, 8, 4}));
-    ASSERT_TRUE(hdf5::read_doubles(f.get(), "/membranes/capsule0/tension", v, dims));
-    EXPECT_EQ(v, a.tension);
-    ASSERT_TRUE(hdf5::read_doubles(f.get(), "/membranes/capsule0/force", v, dims));
+      for (int d = 0; d < 3; ++d) EXPECT_EQ(v[3 * (na + i) + d], b.nodes[i][d]);
+    ASSERT_TRUE(hdf5::read_int32(f.get(), "/membranes/connectivity", conn, dims));
+    EXPECT_EQ(dims, (std::vector<hsize_t>{a.tris.size() + 2, 6}));
+    const std::vector<std::int32_t> second(conn.end() - 12, conn.end());
+    std::vector<std::int32_t> expected{0, 1, 2, 3, 4, 5, 1, 6, 2, 7, 8, 4};
+    for (auto& e : expected) e += static_cast<std::int32_t>(na);
+    EXPECT_EQ(second, expected);
+    ASSERT_TRUE(hdf5::read_int32(f.get(), "/membranes/membrane_id", conn, dims));
+    std::vector<std::int32_t> ids(a.tris.size(), 0);
+    ids.insert(ids.end(), 2, 1);
+    EXPECT_EQ(conn, ids);
+    std::string names;
+    hdf5::Handle group = hdf5::open_group(f.get(), "membranes");
+    ASSERT_TRUE(group.valid() && hdf5::read_attribute(group.get(), "names", names));
+    EXPECT_EQ(names, "capsule0 cell1");
+    ASSERT_TRUE(hdf5::read_doubles(f.get(), "/membranes/tension", v, dims));
+    EXPECT_EQ(std::vector<double>(v.begin(), v.begin() + static_cast<long>(na)), a.tension);
+    ASSERT_TRUE(hdf5::read_doubles(f.get(), "/membranes/force", v, dims));
     for (std::size_t i = 0; i < a.force.size(); ++i)
       for (int d = 0; d < 3; ++d) EXPECT_EQ(v[3 * i + d], a.force[i][d]);
     ASSERT_TRUE(hdf5::read_doubles(f.get(), "/fluid/pressure", v, dims));
@@ -323,15 +335,17 @@ TEST(XdmfWriter, TwoFramesReadBackExactlyAndXdmfReferencesThem) {
   EXPECT_NE(mx.find("CollectionType=\"Temporal\""), std::string::npos);
   EXPECT_EQ(times(mx), (std::vector<std::string>{"0.1", "0.6"}));
   EXPECT_EQ(times(fx), (std::vector<std::string>{"0.1", "0.6"}));
-  EXPECT_NE(mx.find("<Topology TopologyType=\"Triangle_6\" NumberOfElements=\"2\">"), std::string::npos);
+  EXPECT_NE(mx.find("<Topology TopologyType=\"Triangle_6\" NumberOfElements=\""), std::string::npos);
+  EXPECT_NE(mx.find("<Information Name=\"membrane_names\" Value=\"capsule0 cell1\"/>"), std::string::npos);
+  EXPECT_NE(mx.find("<Attribute Name=\"membrane_id\" AttributeType=\"Scalar\" Center=\"Cell\">"), std::string::npos);
   EXPECT_NE(fx.find("<Topology TopologyType=\"3DCoRectMesh\" Dimensions=\"5 3 4\"/>"), std::string::npos);
   // Origin of the cell centres in z, y, x order, then the spacing.
   EXPECT_NE(fx.find("Format=\"XML\">1.125 0.125 -0.375</DataItem>"), std::string::npos) << fx;
   EXPECT_NE(fx.find("Format=\"XML\">0.25 0.25 0.25</DataItem>"), std::string::npos);
   // Every referenced dataset exists with the stated dimensions.
   const auto mrefs = hdf_refs(mx), frefs = hdf_refs(fx);
-  // Per frame: capsule0 and cell1 each have connectivity, nodes and two fields.
-  EXPECT_EQ(mrefs.size(), 2u * (4 + 4));
+  // Per frame, one grid of both membranes: connectivity, nodes, membrane_id, position (the nodes) and two fields.
+  EXPECT_EQ(mrefs.size(), 2u * 6);
   EXPECT_EQ(frefs.size(), 2u * 3);
   for (const auto* refs : {&mrefs, &frefs})
     for (const auto& r : *refs) EXPECT_EQ(dims_of(dir / r.file, r.dataset), r.dims) << r.file << ":" << r.dataset;

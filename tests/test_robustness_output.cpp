@@ -158,7 +158,7 @@ TEST(RobustnessOutput, FolderHoldingARunIsRefusedUnlessOverwriteIsGiven) {
   const auto again = run_immerse(run_args(file, out, small_membrane_sets(1)), scratch / "again");
   expect_one_error_line(again, 2, "immerse: error: ",
                         "--out " + out.string() +
-                            " holds another run (checkpoint.h5, config.resolved.toml, diagnostics.csv, ...): choose "
+                            " holds another run (checkpoint.h5, config.resolved.toml, diagnostics.columns.csv, ...): choose "
                             "another folder, continue it with --restart " + (out / "checkpoint.h5").string() +
                             ", or replace it with --overwrite");
   EXPECT_EQ(again.out, "");
@@ -190,7 +190,7 @@ TEST(RobustnessOutput, RestartIntoTheFolderOfAnotherRunIsRefused) {
                                   scratch / "into_b");
   expect_one_error_line(into_b, 2, "immerse: error: ",
                         "--out " + (scratch / "b").string() +
-                            " holds another run (checkpoint.h5, config.resolved.toml, diagnostics.csv): choose another "
+                            " holds another run (checkpoint.h5, config.resolved.toml, diagnostics.columns.csv, ...): choose another "
                             "folder, restart from that run's own checkpoint, or replace it with --overwrite");
   EXPECT_TRUE(folder_contents(scratch / "b") == before) << "the refused restart changed the other run's folder";
 

@@ -8,6 +8,7 @@
 
 #include "PetscEnvironment.hpp"
 #include "immerse/io/Checkpoint.hpp"
+#include "immerse/io/Hdf5.hpp"
 #include "immerse/simulation/RunSchema.hpp"
 #include "immerse/simulation/Runner.hpp"
 #include "immerse/simulation/Scenario.hpp"
@@ -43,11 +44,58 @@ TEST_F(RunOutputTest, ResolvedConfigurationReparsesToTheConfigurationThatRan) {
   const fs::path saved = options_.out / "config.resolved.toml";
   ASSERT_TRUE(fs::exists(saved));
   EXPECT_TRUE(schema.parse_file(saved, {}) == ran);
-  EXPECT_NE(log_.str().find(ran.to_toml_string()), std::string::npos) << "the resolved configuration is printed";
+  // Standard output is short: the header names the version and the folders; the configuration is not echoed.
+  EXPECT_EQ(log_.str().find(ran.to_toml_string()), std::string::npos) << log_.str();
+  EXPECT_EQ(log_.str().rfind("# immerse " IMMERSE_VERSION " (commit ", 0), 0u) << log_.str();
   // The checkpoint carries it too.
   const auto ck = io::Checkpoint::read(options_.out / "checkpoint.h5");
   EXPECT_TRUE(schema.parse_string(ck.get_string("config"), "checkpoint") == ran);
   EXPECT_EQ(ck.get_int("step"), kSteps);
+}
+
+// --verbose prints the whole resolved configuration as well.
+TEST(RunOutputVerbose, PrintsTheResolvedConfiguration) {
+  ScratchDir dir("output");
+  RunOptions o;
+  o.file = scenario_file("oscillating_membrane_quick.toml");
+  o.sets = small_membrane_sets(1);
+  o.out = dir / "out";
+  o.verbose = true;
+  std::ostringstream log, err;
+  ASSERT_EQ(run_command(o, log, err), 0) << err.str();
+  const io::Config ran = apply_scenario(run_schema().parse_file(o.file, o.sets));
+  EXPECT_NE(log.str().find(ran.to_toml_string()), std::string::npos) << log.str();
+}
+
+// The run folder says where it came from: version, commit, command line, start time, host and threads at the head
+// of config.resolved.toml and as attributes of every HDF5 file; every diagnostics column with its unit.
+TEST_F(RunOutputTest, FilesRecordTheirProvenanceAndUnits) {
+  const std::string toml = read_text(options_.out / "config.resolved.toml");
+  for (const char* key : {"immerse_version", "commit", "command_line", "start_time", "host", "threads"})
+    EXPECT_NE(toml.find(std::string("# ") + key + ": "), std::string::npos) << key;
+  EXPECT_NE(toml.find("# immerse_version: " IMMERSE_VERSION "\n"), std::string::npos);
+  EXPECT_NE(toml.find("# command_line: immerse run " + options_.file.string() + "\n"), std::string::npos) << toml;
+  for (const char* file : {"fields_000000.h5", "checkpoint.h5"}) {
+    io::hdf5::Handle f = io::hdf5::open_file_readonly((options_.out / file).string());
+    ASSERT_TRUE(f.valid()) << file;
+    std::string value;
+    for (const char* key : {"immerse_version", "commit", "command_line", "start_time", "host", "threads"}) {
+      ASSERT_TRUE(io::hdf5::read_attribute(f.get(), key, value)) << file << ": " << key;
+      EXPECT_FALSE(value.empty()) << file << ": " << key;
+    }
+    ASSERT_TRUE(io::hdf5::read_attribute(f.get(), "immerse_version", value));
+    EXPECT_EQ(value, IMMERSE_VERSION);
+  }
+  const auto units = read_csv(options_.out / "diagnostics.columns.csv");
+  const auto rows = read_csv(options_.out / "diagnostics.csv");
+  ASSERT_EQ(units.size(), rows[0].size() + 1);
+  EXPECT_EQ(units[0], (std::vector<std::string>{"column", "unit", "description"}));
+  for (std::size_t c = 0; c < rows[0].size(); ++c) {
+    ASSERT_EQ(units[c + 1].size(), 3u) << rows[0][c];
+    EXPECT_EQ(units[c + 1][0], rows[0][c]);
+  }
+  EXPECT_EQ(units[2][1], "s");    // time
+  EXPECT_EQ(units[9][1], "m^3");  // volume
 }
 
 TEST_F(RunOutputTest, DiagnosticsHaveTheDocumentedHeaderAndOneRowPerStep) {

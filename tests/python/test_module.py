@@ -57,6 +57,8 @@ class Module(unittest.TestCase):
         self.assertEqual(list(rows["step"]), [1, 2, 3, 4, 5])
         self.assertAlmostEqual(sim.time, 0.1, places=12)
         self.assertEqual(set(rows), set(sim.columns))
+        self.assertEqual(list(sim.units), sim.columns)
+        self.assertEqual((sim.units["time"], sim.units["volume"], sim.units["theta"]), ("s", "m^3", "rad"))
         # No force, no flow: nodes and volume unchanged to round-off.
         self.assertLess(np.abs(sim.positions() - X0).max(), 1e-12)
         self.assertLess(np.abs(sim.velocities()).max(), 1e-12)

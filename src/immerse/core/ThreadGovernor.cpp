@@ -163,14 +163,20 @@ std::size_t ThreadGovernor::probe_interval() const {
   return std::max(interval_, static_cast<std::size_t>(std::min(budget, double(kMaxInterval))));
 }
 
+std::string ThreadGovernor::policy() const {
+  std::ostringstream s;
+  if (!adaptive_)
+    s << max_ << " (fixed" << (std::getenv("OMP_NUM_THREADS") ? " by OMP_NUM_THREADS" : "") << ")";
+  else
+    s << "1 or " << max_ << ", chosen by measurement (" << AvailableCpus::of_this_process().describe() << ")";
+  return s.str();
+}
+
 std::string ThreadGovernor::summary() const {
   std::ostringstream s;
   const std::size_t total = count_[0] + count_[1];
-  if (!adaptive_) {
-    s << "threads: " << max_ << " (fixed" << (std::getenv("OMP_NUM_THREADS") ? " by OMP_NUM_THREADS" : "") << ")";
-    return s.str();
-  }
-  s << "threads: 1 or " << max_ << ", chosen by measurement (" << AvailableCpus::of_this_process().describe() << ")";
+  s << "threads: " << policy();
+  if (!adaptive_) return s.str();
   if (total > 0) {
     const double one = 100.0 * static_cast<double>(count_[0]) / static_cast<double>(total);
     s.precision(3);

@@ -47,6 +47,8 @@ class ThreadGovernor {
   int max_threads() const { return max_; }
   /// Evaluations run with one thread and with max_threads so far.
   std::size_t evaluations(int threads) const { return threads == 1 ? count_[0] : count_[1]; }
+  /// The policy: "2 (fixed by OMP_NUM_THREADS)" or "1 or 2, chosen by measurement (2 CPUs: ...)".
+  std::string policy() const;
   /// One line for the run's summary: the policy and how the evaluations were spread over the thread counts.
   std::string summary() const;
 

@@ -164,6 +164,7 @@ void Checkpoint::write(const std::filesystem::path& path) const {
   const hid_t root = file.get();
   check(hdf5::write_attribute(root, kVersionAttr, kFormatVersion), "format version");
   check(hdf5::write_attribute(root, kChecksumAttr, checksum()), "checksum");
+  for (const auto& [name, value] : attributes_) check(hdf5::write_attribute(root, name, value), name);
   hdf5::Handle arrays = hdf5::create_group(root, "arrays");
   hdf5::Handle ints = hdf5::create_group(root, "int64");
   hdf5::Handle doubles = hdf5::create_group(root, "double");

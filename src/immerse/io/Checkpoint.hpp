@@ -11,6 +11,7 @@
 #include <filesystem>
 #include <map>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace immerse::io {
@@ -39,6 +40,12 @@ class Checkpoint {
   double get_double(const std::string& name) const;
   const std::string& get_string(const std::string& name) const;
 
+  /// String attributes written on the file's root beside the entries (the run's provenance); not entries: they
+  /// are neither checksummed nor compared, and reading does not return them.
+  void set_attributes(std::vector<std::pair<std::string, std::string>> attributes) {
+    attributes_ = std::move(attributes);
+  }
+
   /// The file it was read from ("(in memory)" for one built by the program).
   const std::string& source() const { return source_; }
 
@@ -64,6 +71,7 @@ class Checkpoint {
   std::map<std::string, std::int64_t> ints_;
   std::map<std::string, double> doubles_;
   std::map<std::string, std::string> strings_;
+  std::vector<std::pair<std::string, std::string>> attributes_;
   std::string source_ = "(in memory)";
 };
 

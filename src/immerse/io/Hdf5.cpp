@@ -219,12 +219,15 @@ bool write_attribute(hid_t obj, const std::string& name, const std::vector<std::
   const std::int64_t dummy = 0;
   return a.valid() && H5Awrite(a.get(), H5T_NATIVE_INT64, n ? value.data() : &dummy) >= 0;
 }
+// A variable-length UTF-8 string: h5py and other readers return it as text (a fixed-length one comes back as bytes).
 bool write_attribute(hid_t obj, const std::string& name, const std::string& value) {
-  Handle type = string_type(value.size());
+  Handle type(H5Tcopy(H5T_C_S1), H5Tclose);
+  if (!type.valid() || H5Tset_size(type.get(), H5T_VARIABLE) < 0 || H5Tset_cset(type.get(), H5T_CSET_UTF8) < 0)
+    return false;
   Handle space(H5Screate(H5S_SCALAR), H5Sclose);
   Handle a(H5Acreate2(obj, name.c_str(), type.get(), space.get(), H5P_DEFAULT, H5P_DEFAULT), H5Aclose);
-  const std::string padded = value.empty() ? std::string(1, '\0') : value;
-  return a.valid() && H5Awrite(a.get(), type.get(), padded.data()) >= 0;
+  const char* text = value.c_str();
+  return a.valid() && H5Awrite(a.get(), type.get(), &text) >= 0;
 }
 
 bool read_attribute(hid_t obj, const std::string& name, std::int64_t& value) {
@@ -250,8 +253,18 @@ bool read_attribute(hid_t obj, const std::string& name, std::string& value) {
   Handle a(H5Aopen(obj, name.c_str(), H5P_DEFAULT), H5Aclose);
   if (!a.valid()) return false;
   Handle type(H5Aget_type(a.get()), H5Tclose);
-  if (!type.valid() || H5Tget_class(type.get()) != H5T_STRING || H5Tis_variable_str(type.get()) != 0) return false;
-  value.assign(H5Tget_size(type.get()), '\0');
+  if (!type.valid() || H5Tget_class(type.get()) != H5T_STRING) return false;
+  if (H5Tis_variable_str(type.get()) > 0) {
+    Handle memtype(H5Tcopy(H5T_C_S1), H5Tclose);
+    char* text = nullptr;
+    if (!memtype.valid() || H5Tset_size(memtype.get(), H5T_VARIABLE) < 0 ||
+        H5Tset_cset(memtype.get(), H5Tget_cset(type.get())) < 0 || H5Aread(a.get(), memtype.get(), &text) < 0)
+      return false;
+    value = text ? text : "";
+    H5free_memory(text);
+    return true;
+  }
+  value.assign(H5Tget_size(type.get()), '\0');  // fixed length (files of earlier versions)
   if (value.empty() || H5Aread(a.get(), type.get(), value.data()) < 0) return false;
   while (!value.empty() && value.back() == '\0') value.pop_back();
   return true;

@@ -21,8 +21,8 @@ bool all_digits(const std::string& s, std::size_t from) {
 }  // namespace
 
 bool OutputFolder::is_run_file(const std::string& name) {
-  for (const char* n : {"config.resolved.toml", "diagnostics.csv", "stretch.csv", "checkpoint.h5", "membranes.xdmf",
-                        "fluid.xdmf"})
+  for (const char* n : {"config.resolved.toml", "diagnostics.csv", "diagnostics.columns.csv", "stretch.csv",
+                        "stretch.columns.csv", "checkpoint.h5", "membranes.xdmf", "fluid.xdmf"})
     if (name == n) return true;
   // fields_NNNNNN.h5 (at least six digits)
   const std::string head = "fields_", tail = ".h5";

@@ -35,9 +35,9 @@ std::string data_item(const std::string& file, const std::string& dataset, const
          "\" Precision=\"" + (integer ? "4" : "8") + "\" Format=\"HDF\">" + file + ":" + dataset + "</DataItem>";
 }
 
-std::string attribute(const std::string& name, bool vector, const std::string& item) {
-  return "        <Attribute Name=\"" + name + "\" AttributeType=\"" + (vector ? "Vector" : "Scalar") +
-         "\" Center=\"Node\">\n          " + item + "\n        </Attribute>\n";
+std::string attribute(const std::string& name, const char* type, const char* center, const std::string& item) {
+  return "      <Attribute Name=\"" + name + "\" AttributeType=\"" + type + "\" Center=\"" + center + "\">\n        " +
+         item + "\n      </Attribute>\n";
 }
 
 std::vector<double> flatten(std::span<const Vec3> v) {
@@ -100,49 +100,87 @@ std::filesystem::path XdmfWriter::write_frame(double time, std::span<const Surfa
   hdf5::Handle file = hdf5::create_memory_file(path.string());
   check(file.valid(), "the file");
   check(hdf5::write_attribute(file.get(), "time", time), "time");
+  for (const auto& [name, value] : attributes_) check(hdf5::write_attribute(file.get(), name, value), name);
 
-  // Membranes: one spatial collection per frame.
-  std::string mx = "    <Grid Name=\"membranes_" + std::string(tag) +
-                   "\" GridType=\"Collection\" CollectionType=\"Spatial\">\n      <Time Value=\"" + t + "\"/>\n";
-  hdf5::Handle mgroup = hdf5::create_group(file.get(), "membranes");
-  check(mgroup.valid(), "/membranes");
-  for (const auto& m : membranes) {
-    check_name("membrane", m.name);
-    const std::string base = "/membranes/" + m.name;
-    const hsize_t nn = m.nodes.size(), nt = m.triangles.size();
-    hdf5::Handle g = hdf5::create_group(mgroup.get(), m.name);
-    check(g.valid(), base);
-    std::vector<std::int32_t> conn;
+  // Membranes: all surfaces of the frame in one grid (readable by meshio's XDMF time series as well as ParaView),
+  // each element tagged with its membrane's index (cell data membrane_id), the names listed in order.
+  std::string mx;
+  if (!membranes.empty()) {
+    hsize_t nn = 0, nt = 0;
+    std::string names;
+    for (const auto& m : membranes) {
+      check_name("membrane", m.name);
+      names += (names.empty() ? "" : " ") + m.name;
+      nn += m.nodes.size();
+      nt += m.triangles.size();
+      const auto& first = membranes.front();
+      bool same = m.vectors.size() == first.vectors.size() && m.scalars.size() == first.scalars.size();
+      for (std::size_t i = 0; same && i < m.vectors.size(); ++i) same = m.vectors[i].first == first.vectors[i].first;
+      for (std::size_t i = 0; same && i < m.scalars.size(); ++i) same = m.scalars[i].first == first.scalars[i].first;
+      if (!same) throw std::logic_error("XdmfWriter: membrane " + m.name + " has other fields than " + first.name);
+    }
+    std::vector<double> nodes;
+    std::vector<std::int32_t> conn, id;
+    std::vector<std::int64_t> node_offsets{0};
+    nodes.reserve(3 * nn);
     conn.reserve(6 * nt);
-    for (const auto& tri : m.triangles)
-      for (const int v : tri) {
-        if (v < 0 || static_cast<hsize_t>(v) >= nn)
-          throw std::logic_error("XdmfWriter: membrane " + m.name + " has a triangle node outside its nodes");
-        conn.push_back(v);
+    id.reserve(nt);
+    for (std::size_t k = 0; k < membranes.size(); ++k) {
+      const auto& m = membranes[k];
+      const auto offset = static_cast<std::int32_t>(node_offsets.back());
+      for (const auto& tri : m.triangles)
+        for (const int v : tri) {
+          if (v < 0 || static_cast<std::size_t>(v) >= m.nodes.size())
+            throw std::logic_error("XdmfWriter: membrane " + m.name + " has a triangle node outside its nodes");
+          conn.push_back(offset + v);
+        }
+      id.insert(id.end(), m.triangles.size(), static_cast<std::int32_t>(k));
+      const auto x = flatten(m.nodes);
+      nodes.insert(nodes.end(), x.begin(), x.end());
+      node_offsets.push_back(node_offsets.back() + static_cast<std::int64_t>(m.nodes.size()));
+    }
+    hdf5::Handle g = hdf5::create_group(file.get(), "membranes");
+    check(g.valid() && hdf5::write_attribute(g.get(), "names", names), "/membranes");
+    check(hdf5::write_doubles(g.get(), "nodes", nodes.data(), {nn, 3}), "/membranes/nodes");
+    check(hdf5::write_int32(g.get(), "connectivity", conn.data(), {nt, 6}), "/membranes/connectivity");
+    check(hdf5::write_int32(g.get(), "membrane_id", id.data(), {nt}), "/membranes/membrane_id");
+    check(hdf5::write_int64(g.get(), "node_offsets", node_offsets.data(), {node_offsets.size()}),
+          "/membranes/node_offsets");
+    mx = "    <Grid Name=\"membranes_" + std::string(tag) + "\" GridType=\"Uniform\">\n      <Time Value=\"" + t +
+         "\"/>\n      <Information Name=\"membrane_names\" Value=\"" + names + "\"/>\n"
+         "      <Topology TopologyType=\"Triangle_6\" NumberOfElements=\"" + std::to_string(nt) + "\">\n"
+         "        " + data_item(fname, "/membranes/connectivity", {nt, 6}, true) + "\n      </Topology>\n"
+         "      <Geometry GeometryType=\"XYZ\">\n        " + data_item(fname, "/membranes/nodes", {nn, 3}, false) +
+         "\n      </Geometry>\n" +
+         attribute("membrane_id", "Scalar", "Cell", data_item(fname, "/membranes/membrane_id", {nt}, true)) +
+         // The node positions again as a field: readers of a fixed mesh (meshio) get the moving surface per frame.
+         attribute("position", "Vector", "Node", data_item(fname, "/membranes/nodes", {nn, 3}, false));
+    const auto field = [&](const std::string& name, auto member, std::size_t width) {
+      check_name("field", name);
+      std::vector<double> all;
+      all.reserve(width * nn);
+      for (const auto& m : membranes) {
+        const auto& v = member(m);
+        if (v.size() != m.nodes.size())
+          throw std::logic_error("XdmfWriter: field " + name + " of " + m.name + " has wrong size");
+        if constexpr (std::is_same_v<std::decay_t<decltype(v[0])>, Vec3>) {
+          const auto x = flatten(v);
+          all.insert(all.end(), x.begin(), x.end());
+        } else {
+          all.insert(all.end(), v.begin(), v.end());
+        }
       }
-    check(hdf5::write_doubles(g.get(), "nodes", flatten(m.nodes).data(), {nn, 3}), base + "/nodes");
-    check(hdf5::write_int32(g.get(), "connectivity", conn.data(), {nt, 6}), base + "/connectivity");
-    mx += "      <Grid Name=\"" + m.name + "\" GridType=\"Uniform\">\n"
-          "        <Topology TopologyType=\"Triangle_6\" NumberOfElements=\"" + std::to_string(nt) + "\">\n"
-          "          " + data_item(fname, base + "/connectivity", {nt, 6}, true) + "\n        </Topology>\n"
-          "        <Geometry GeometryType=\"XYZ\">\n          " + data_item(fname, base + "/nodes", {nn, 3}, false) +
-          "\n        </Geometry>\n";
-    for (const auto& [name, v] : m.vectors) {
-      check_name("field", name);
-      if (v.size() != nn) throw std::logic_error("XdmfWriter: field " + name + " of " + m.name + " has wrong size");
-      check(hdf5::write_doubles(g.get(), name, flatten(v).data(), {nn, 3}), base + "/" + name);
-      mx += attribute(name, true, data_item(fname, base + "/" + name, {nn, 3}, false));
-    }
-    for (const auto& [name, v] : m.scalars) {
-      check_name("field", name);
-      if (v.size() != nn) throw std::logic_error("XdmfWriter: field " + name + " of " + m.name + " has wrong size");
-      check(hdf5::write_doubles(g.get(), name, v.data(), {nn}), base + "/" + name);
-      mx += attribute(name, false, data_item(fname, base + "/" + name, {nn}, false));
-    }
-    mx += "      </Grid>\n";
+      const std::vector<hsize_t> dims = width == 3 ? std::vector<hsize_t>{nn, 3} : std::vector<hsize_t>{nn};
+      check(hdf5::write_doubles(g.get(), name, all.data(), dims), "/membranes/" + name);
+      mx += attribute(name, width == 3 ? "Vector" : "Scalar", "Node", data_item(fname, "/membranes/" + name, dims, false));
+    };
+    for (std::size_t i = 0; i < membranes.front().vectors.size(); ++i)
+      field(membranes.front().vectors[i].first, [i](const SurfaceFrame& m) { return m.vectors[i].second; }, 3);
+    for (std::size_t i = 0; i < membranes.front().scalars.size(); ++i)
+      field(membranes.front().scalars[i].first, [i](const SurfaceFrame& m) { return m.scalars[i].second; }, 1);
+    mx += "    </Grid>\n";
+    check(g.close(), "/membranes");
   }
-  mx += "    </Grid>\n";
-  check(mgroup.close(), "/membranes");
 
   // Fluid: cell-centred fields on a 3DCoRectMesh (XDMF orders dimensions, origin and spacing z, y, x).
   std::string fx;
@@ -174,9 +212,9 @@ std::filesystem::path XdmfWriter::write_frame(double time, std::span<const Surfa
          format_number(c0.z) + " " + format_number(c0.y) + " " + format_number(c0.x) +
          "</DataItem>\n        <DataItem Dimensions=\"3\" NumberType=\"Float\" Precision=\"8\" Format=\"XML\">" +
          format_number(h) + " " + format_number(h) + " " + format_number(h) + "</DataItem>\n      </Geometry>\n" +
-         attribute("velocity", true, data_item(fname, "/fluid/velocity", vdims, false)) +
-         attribute("pressure", false, data_item(fname, "/fluid/pressure", sdims, false)) +
-         attribute("vorticity_magnitude", false, data_item(fname, "/fluid/vorticity_magnitude", sdims, false)) +
+         attribute("velocity", "Vector", "Node", data_item(fname, "/fluid/velocity", vdims, false)) +
+         attribute("pressure", "Scalar", "Node", data_item(fname, "/fluid/pressure", sdims, false)) +
+         attribute("vorticity_magnitude", "Scalar", "Node", data_item(fname, "/fluid/vorticity_magnitude", sdims, false)) +
          "    </Grid>\n";
   }
   check(hdf5::write_attribute(file.get(), kMembraneAttr, mx) && hdf5::write_attribute(file.get(), kFluidAttr, fx),

@@ -1,13 +1,17 @@
 #pragma once
 // ParaView output: one HDF5 file per output frame (DIR/fields_000012.h5) and two XDMF 3 files describing the
 // whole time series (temporal collections), rewritten atomically after every frame:
-//   DIR/membranes.xdmf  every membrane as a surface of 6-node quadratic triangles (TopologyType "Triangle_6",
-//                       node order: vertices 0, 1, 2, then mid-sides 0-1, 1-2, 2-0, as VTK_QUADRATIC_TRIANGLE)
-//                       with node fields (vectors such as force and velocity, scalars such as tension invariants);
+//   DIR/membranes.xdmf  all membranes of a frame as one surface of 6-node quadratic triangles (TopologyType
+//                       "Triangle_6", node order: vertices 0, 1, 2, then mid-sides 0-1, 1-2, 2-0, as
+//                       VTK_QUADRATIC_TRIANGLE) with cell data membrane_id (the membrane's index; names in order in
+//                       the grid's Information "membrane_names") and node fields (position, vectors such as force
+//                       and velocity, scalars such as tension invariants); meshio.xdmf.TimeSeriesReader reads it;
 //   DIR/fluid.xdmf      the fluid on the cell centres of the MAC grid (3DCoRectMesh): cell-centred velocity,
 //                       pressure and vorticity magnitude (CellFields).
-// HDF5 layout of a frame: attribute "time"; /membranes/<name>/{nodes [N,3], connectivity [T,6] int32,
-// <field> [N,3] or [N]}; /fluid/{velocity [nz,ny,nx,3], pressure [nz,ny,nx], vorticity_magnitude [nz,ny,nx]}.
+// HDF5 layout of a frame: attributes "time" and the run's provenance; /membranes/{nodes [N,3], connectivity [T,6]
+// int32, membrane_id [T] int32, node_offsets [M+1] int64 (membrane k owns nodes node_offsets[k] ..
+// node_offsets[k+1]-1), <field> [N,3] or [N]} with attribute "names" (space-separated, in order);
+// /fluid/{velocity [nz,ny,nx,3], pressure [nz,ny,nx], vorticity_magnitude [nz,ny,nx]}.
 // Each frame file also stores its own XDMF fragments (attributes), so a restarted run can rebuild the series.
 // Each frame appends its fragments to the series files (rewritten atomically through a fixed buffer), so the
 // writer's memory does not grow with the number of frames.
@@ -25,7 +29,8 @@
 
 namespace immerse::io {
 
-/// One membrane surface at one output time. Names are [A-Za-z0-9_.-]; every field has one value per node.
+/// One membrane surface at one output time. Names are [A-Za-z0-9_.-]; every field has one value per node; all
+/// membranes of a frame have the same fields in the same order.
 struct SurfaceFrame {
   std::string name;
   std::span<const Vec3> nodes;
@@ -53,6 +58,11 @@ class XdmfWriter {
   std::filesystem::path write_frame(double time, std::span<const SurfaceFrame> membranes,
                                     const FluidFrame* fluid = nullptr);
 
+  /// String attributes written on the root of every later frame file (the run's provenance).
+  void set_attributes(std::vector<std::pair<std::string, std::string>> attributes) {
+    attributes_ = std::move(attributes);
+  }
+
   int frames() const { return frames_; }
   const std::filesystem::path& dir() const { return dir_; }
   static std::string frame_file_name(int frame);
@@ -63,6 +73,7 @@ class XdmfWriter {
 
   std::filesystem::path dir_;
   int frames_ = 0;
+  std::vector<std::pair<std::string, std::string>> attributes_;
 };
 
 }  // namespace immerse::io

@@ -1,17 +1,41 @@
 #include "immerse/simulation/Diagnostics.hpp"
 
 #include <cmath>
+#include <stdexcept>
 
 #include "immerse/membrane/CellDiameters.hpp"
+#include "immerse/simulation/Scenario.hpp"
 #include "immerse/simulation/ShearPlaneProfile.hpp"
 
 namespace immerse {
 
 namespace {
 
-const std::vector<std::string> kStepColumns{"step",         "time",     "dt",       "newton_its",
-                                            "gmres_its",    "fluid_solves", "residual", "wall_s"};
-const std::vector<std::string> kMembraneColumns{"volume", "area", "cx", "cy", "cz", "a1", "a2", "a3", "D_xz", "theta"};
+// Units as UDUNITS writes them ("1": a number without unit).
+const std::vector<Column> kStepColumns{
+    {"step", "1", "time step number"},
+    {"time", "s", "simulated time t"},
+    {"dt", "s", "step size that reached this step (0 on the first row of a series: the initial state or the restart)"},
+    {"newton_its", "1", "nonlinear iterations of the step"},
+    {"gmres_its", "1", "GMRES iterations of the step (jfnk)"},
+    {"fluid_solves", "1", "fluid solves (residual evaluations) of the step"},
+    {"residual", "1", "final relative Newton residual ||g|| / ||X|| (0 for explicit schemes)"},
+    {"wall_s", "s", "wall-clock time of the step"}};
+const Column kShearTime{"kt", "1", "nondimensional time: shear rate k times t"};
+const std::vector<Column> kMembraneColumns{
+    {"volume", "m^3", "enclosed volume"},
+    {"area", "m^2", "surface area"},
+    {"cx", "m", "centroid x"},
+    {"cy", "m", "centroid y"},
+    {"cz", "m", "centroid z"},
+    {"a1", "m", "semi-axis of the equivalent ellipsoid (same volume inertia) closest to x"},
+    {"a2", "m", "semi-axis of the equivalent ellipsoid closest to y"},
+    {"a3", "m", "semi-axis of the equivalent ellipsoid closest to z"},
+    {"D_xz", "1", "Taylor deformation (L - B) / (L + B) of the section by the x-z plane through the centroid"},
+    {"theta", "rad", "inclination of the longest principal axis to x in the x-z plane"}};
+const std::vector<Column> kCellColumns{{"axial_um", "um", "largest extent of the cell along the force (x) or the flow (y)"},
+                                       {"transverse_um", "um", "largest extent along either other coordinate axis"}};
+const Column kMeanVelocity{"mean_velocity", "m/s", "mean fluid velocity along the flow (y) over the box"};
 
 // The axis along which a cell's axial diameter is measured: the force (x) or the flow (y).
 int cell_axis(const io::Config& c) { return is_channel(c) ? 1 : 0; }
@@ -31,17 +55,37 @@ bool is_sweep(const io::Config& c) { return c.get<std::string>("scenario.kind") 
 bool is_channel(const io::Config& c) { return c.get<std::string>("scenario.kind") == "rbc_channel"; }
 bool is_cell_scenario(const io::Config& c) { return is_sweep(c) || is_channel(c); }
 
-std::vector<std::string> diagnostics_columns(const io::Config& config, std::size_t membranes) {
+std::vector<Column> diagnostics_column_info(const io::Config& config, std::size_t membranes) {
   auto cols = kStepColumns;
+  if (shear_rate(config) > 0) cols.insert(cols.begin() + 2, kShearTime);
   for (std::size_t m = 0; m < membranes; ++m) {
-    std::string prefix;
-    if (membranes > 1) prefix.append("m").append(std::to_string(m)).append("_");
-    for (const auto& c : kMembraneColumns) cols.push_back(prefix + c);
+    std::string prefix, whose;
+    if (membranes > 1) {
+      prefix.append("m").append(std::to_string(m)).append("_");
+      whose = " of membrane[" + std::to_string(m) + "]";
+    }
+    for (const auto& c : kMembraneColumns) cols.push_back({prefix + c.name, c.unit, c.description + whose});
     if (is_cell_scenario(config))
-      for (const char* c : {"axial_um", "transverse_um"}) cols.push_back(prefix + c);
+      for (const auto& c : kCellColumns) cols.push_back({prefix + c.name, c.unit, c.description + whose});
   }
-  if (is_channel(config)) cols.push_back("mean_velocity");
+  if (is_channel(config)) cols.push_back(kMeanVelocity);
   return cols;
+}
+
+std::vector<std::string> diagnostics_columns(const io::Config& config, std::size_t membranes) {
+  std::vector<std::string> names;
+  for (const auto& c : diagnostics_column_info(config, membranes)) names.push_back(c.name);
+  return names;
+}
+
+std::string column_table(const std::vector<Column>& columns) {
+  std::string out = "column,unit,description\n";
+  for (const auto& c : columns) {
+    if ((c.name + c.unit + c.description).find_first_of(",\"\n") != std::string::npos)
+      throw std::logic_error("column_table: column " + c.name + " has a comma, quote or line break in its text");
+    out += c.name + "," + c.unit + "," + c.description + "\n";
+  }
+  return out;
 }
 
 // The principal semi-axes ordered by the coordinate axis their direction is closest to (a1 ~ x, a2 ~ y, a3 ~ z),
@@ -68,14 +112,14 @@ double inclination(const MembraneGeometry& g) {
 }
 
 std::vector<double> diagnostics_row(const Simulation& sim, const StepRecord& r) {
-  std::vector<double> row{double(r.step),
-                          r.time,
-                          r.dt,
+  std::vector<double> row{double(r.step), r.time};
+  if (const double k = shear_rate(sim.config()); k > 0) row.push_back(k * r.time);
+  row.insert(row.end(), {r.dt,
                           double(r.stats.newton_its),
                           double(r.stats.gmres_its),
                           double(r.stats.fluid_solves),
                           r.stats.residual,
-                          r.wall_seconds};
+                          r.wall_seconds});
   for (std::size_t m = 0; m < sim.num_membranes(); ++m) {
     const auto X = sim.op().membrane_positions(m);
     const MembraneGeometry g = measure(sim.mesh(m), X);

@@ -19,6 +19,16 @@ bool is_channel(const io::Config& c);
 /// The red-cell scenarios, whose rows carry the cells' axial and transverse diameters.
 bool is_cell_scenario(const io::Config& c);
 
+/// A column of a CSV table: its name, its unit (UDUNITS form, "1" for a pure number) and what it holds.
+struct Column {
+  std::string name, unit, description;
+};
+
+/// The columns of diagnostics.csv for this configuration and number of membranes (a column kt, the
+/// nondimensional time, follows time where the scenario defines a shear rate).
+std::vector<Column> diagnostics_column_info(const io::Config& config, std::size_t membranes);
+/// The table of columns that is written beside a CSV file (NAME.columns.csv): column,unit,description.
+std::string column_table(const std::vector<Column>& columns);
 /// The column names of diagnostics.csv for this configuration and number of membranes.
 std::vector<std::string> diagnostics_columns(const io::Config& config, std::size_t membranes);
 /// The row of diagnostics.csv after the step r (the membranes' committed state).

@@ -18,6 +18,8 @@
 #include "immerse/io/AtomicFile.hpp"
 #include "immerse/io/CsvWriter.hpp"
 #include "immerse/io/OutputFolder.hpp"
+#include "immerse/io/Provenance.hpp"
+#include "immerse/io/TomlFormat.hpp"
 #include "immerse/io/XdmfWriter.hpp"
 #include "immerse/membrane/Geometry.hpp"
 #include "immerse/simulation/Callback.hpp"
@@ -108,6 +110,25 @@ class StopSignals {
   static constexpr std::array<int, 5> kSignals{SIGINT, SIGTERM, SIGHUP, SIGQUIT, SIGPIPE};
   std::array<struct sigaction, 5> saved_{};
 };
+
+const std::vector<Column> kStretchColumns{{"force_pN", "pN", "stretching force on each contact patch"},
+                                          {"axial_um", "um", "steady diameter along the force (x)"},
+                                          {"transverse_um", "um", "steady largest diameter across the force"}};
+
+// "KEY = VALUE (how)" for every key a scenario kind derived, the membranes' keys as membrane[i].KEY.
+std::vector<std::string> derived_values(const io::Config& config) {
+  std::vector<std::string> lines;
+  const auto add = [&](const io::Config& c, const std::string& prefix) {
+    for (const auto& k : c.schema().keys())
+      if (const std::string how = c.derivation(k.key); !how.empty())
+        lines.push_back(prefix + k.key + " = " + c.value_text(k.key) + " (" + how + ")");
+  };
+  add(config, "");
+  for (const auto& t : config.schema().table_arrays())
+    for (std::size_t i = 0; i < config.count(t.name); ++i)
+      add(config.entry(t.name, i), t.name + "[" + std::to_string(i) + "].");
+  return lines;
+}
 
 bool same_folder(const std::filesystem::path& a, const std::filesystem::path& b) {
   std::error_code ec;
@@ -242,8 +263,10 @@ int run_command(const RunOptions& options, std::ostream& out, std::ostream& err)
                      ", or replace it with --overwrite");
   }
   // A restart continues the tables after the checkpoint (a damaged table is refused before anything is rewritten).
+  const auto column_info = diagnostics_column_info(config, sim.num_membranes());
   const auto columns = diagnostics_columns(config, sim.num_membranes());
-  const std::vector<std::string> stretch_columns{"force_pN", "axial_um", "transverse_um"};
+  std::vector<std::string> stretch_columns;
+  for (const auto& c : kStretchColumns) stretch_columns.push_back(c.name);
   std::optional<std::string> kept_diagnostics, kept_stretch;
   if (in_place) {
     io::CsvWriter::check_continuable(dir / "diagnostics.csv", columns);
@@ -256,19 +279,31 @@ int run_command(const RunOptions& options, std::ostream& out, std::ostream& err)
   }
 
   // 3. Output. A folder this run created is removed again if its first files cannot be written.
+  io::Provenance provenance = io::Provenance::now(
+      options.command_line.empty() ? "immerse run " + options.file.string() : options.command_line,
+      sim.op().thread_governor().policy());
+  if (restarted)
+    provenance.restarted_from = options.restart.string() + " at step " + std::to_string(sim.step()) + ", t = " +
+                                io::format_number(sim.time()) + (in_place ? " (continued)" : " (branched)");
   std::optional<io::XdmfWriter> frames_opt;
   std::optional<io::CsvWriter> csv_opt, stretch;
   try {
     frames_opt.emplace(dir, first_frame);  // a restart reads back the frames before the checkpoint first
+    frames_opt->set_attributes(provenance.attributes());
     if (options.overwrite) folder.remove_run_files();
     folder.remove_temporaries();  // of a writer that was killed
     if (kept_diagnostics) io::AtomicFile::write(dir / "diagnostics.csv", *kept_diagnostics);
     if (kept_stretch) io::AtomicFile::write(dir / "stretch.csv", *kept_stretch);
 
-    out << "# immerse " << IMMERSE_VERSION << ": " << options.file.string() << " -> " << dir.string() << "\n"
-        << "# resolved configuration (saved as config.resolved.toml)\n"
-        << config.to_toml_string() << std::flush;
-    config.save(dir / "config.resolved.toml");
+    out << "# immerse " << provenance.version << " (commit " << provenance.commit << "): " << options.file.string()
+        << " -> " << dir.string() << "\n";
+    for (const auto& line : derived_values(config)) out << "# derived: " << line << "\n";
+    if (options.verbose)
+      out << "# resolved configuration (saved as config.resolved.toml)\n" << config.to_toml_string();
+    out << std::flush;
+    io::AtomicFile::write(dir / "config.resolved.toml", provenance.toml_comments() + config.to_toml_string());
+    io::AtomicFile::write(dir / "diagnostics.columns.csv", column_table(column_info));
+    if (sweep) io::AtomicFile::write(dir / "stretch.columns.csv", column_table(kStretchColumns));
 
     const auto mode = in_place ? io::CsvWriter::Mode::Append : io::CsvWriter::Mode::Create;
     csv_opt.emplace(dir / "diagnostics.csv", columns, mode);
@@ -299,6 +334,7 @@ int run_command(const RunOptions& options, std::ostream& out, std::ostream& err)
        [&](const Simulation& s) {
          io::Checkpoint ck = s.checkpoint();
          if (sweep) sweep->save(ck);
+         ck.set_attributes(provenance.attributes());
          ck.write(dir / "checkpoint.h5");
          checkpoint_step = s.step();
        }},

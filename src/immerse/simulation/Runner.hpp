@@ -18,6 +18,8 @@ struct RunOptions {
   std::filesystem::path out = "out";
   std::filesystem::path restart;  ///< empty: start from t = 0
   bool overwrite = false;         ///< remove the run files of another run in `out` first
+  bool verbose = false;           ///< print the whole resolved configuration before the run
+  std::string command_line;       ///< recorded in the run folder (Provenance); "immerse run FILE" if empty
 };
 
 /// Exit status: 0 done, 2 bad input (nothing written), 3 the run became unstable, 4 interrupted by a signal,
