@@ -12,6 +12,7 @@
 #include "immerse/io/CellFields.hpp"
 #include "immerse/io/CsvWriter.hpp"
 #include "immerse/io/Hdf5.hpp"
+#include "immerse/io/OutputFolder.hpp"
 #include "immerse/io/XdmfWriter.hpp"
 
 using namespace immerse;
@@ -373,4 +374,21 @@ TEST(XdmfWriter, RestartContinuesTheSeries) {
                                                        " is missing, truncated or not written by immerse");
   std::ofstream(dir.parent_path() / "xdmf_plain") << "x";
   EXPECT_EQ(error_of([&] { XdmfWriter(dir.parent_path() / "xdmf_plain" / "out"); }).rfind("cannot write ", 0), 0u);
+}
+
+// The copies of mesh files count as a run's files (listed, removed by --overwrite); a user's own mesh file in the
+// folder does not.
+TEST(OutputFolderFiles, MeshCopiesAreRunFiles) {
+  for (const char* name : {"mesh_membrane0.msh", "mesh_membrane12_reference.msh", "mesh_membrane3.msh.tmp.77"})
+    EXPECT_TRUE(OutputFolder::is_run_file(name) || OutputFolder::is_temporary(name)) << name;
+  for (const char* name : {"cell.msh", "mesh_membrane.msh", "mesh_membrane0_rest.msh", "mesh_membranex.msh"})
+    EXPECT_FALSE(OutputFolder::is_run_file(name)) << name;
+  const fs::path dir = scratch("mesh_copies");
+  for (const char* name : {"mesh_membrane0.msh", "mesh_membrane0_reference.msh", "cell.msh"})
+    std::ofstream(dir / name) << "x";
+  OutputFolder folder(dir);
+  EXPECT_EQ(folder.run_files(), (std::vector<std::string>{"mesh_membrane0.msh", "mesh_membrane0_reference.msh"}));
+  folder.remove_run_files();
+  EXPECT_TRUE(folder.run_files().empty());
+  EXPECT_TRUE(fs::exists(dir / "cell.msh"));
 }

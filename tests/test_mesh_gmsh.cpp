@@ -131,6 +131,28 @@ TEST(GmshReader, ReadsFormat41) {
   EXPECT_NEAR(volume(m, m.nodes), 4.0 / 3.0, 1e-14);
 }
 
+// Some editors start a text file with a UTF-8 byte-order mark; it is not part of "$MeshFormat".
+TEST(GmshReader, AcceptsAByteOrderMark) {
+  const Mesh m = read_text("\xEF\xBB\xBF" + octahedron_v2());
+  EXPECT_EQ(m.num_elements(), 8u);
+  EXPECT_NEAR(volume(m, m.nodes), 4.0 / 3.0, 1e-14);
+}
+
+// Two closed surfaces in one file (two octahedra, each closed and outward): refused naming the count.
+TEST(GmshReader, RejectsMoreThanOneClosedSurface) {
+  std::ostringstream coords;
+  for (int copy = 0; copy < 2; ++copy)
+    for (int i = 0; i < 6; ++i)
+      coords << 6 * copy + i + 1 << " " << kOctNodes[i][0] + 3 * copy << " " << kOctNodes[i][1] << " "
+             << kOctNodes[i][2] << "\n";
+  auto faces = kOctFaces;
+  for (const auto& f : kOctFaces) faces.push_back({f[0] + 6, f[1] + 6, f[2] + 6});
+  std::string text = octahedron_v2(faces, coords.str());
+  text.replace(text.find("$Nodes\n6\n"), 9, "$Nodes\n12\n");
+  EXPECT_EQ(error_of(text), "mesh " + temp_path("cell.msh").string() +
+                                ": holds 2 separate closed surfaces: must be one (give each its own [[membrane]] and file)");
+}
+
 TEST(GmshReader, RejectsAnOpenSurface) {
   auto faces = kOctFaces;
   faces.pop_back();

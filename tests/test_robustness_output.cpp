@@ -13,6 +13,7 @@
 #include <cstdlib>
 #include <map>
 
+#include "immerse/membrane/MeshGenerator.hpp"
 #include "test_run_support.hpp"
 
 using namespace immerse::testing;
@@ -217,18 +218,18 @@ TEST(RobustnessOutput, TemporaryOfAKilledWriterIsRemovedAtTheNextRun) {
   EXPECT_TRUE(fs::exists(out / "notes.txt.tmp.4242"));
 }
 
-// The first file of a new folder cannot be written: config.resolved.toml made longer than the file-size limit (a
-// 70 kB value of a key this run does not use; a lower limit would hit OpenMPI's own files first). The folder is not
-// left behind, and the status says nothing was written.
+// The first files of a new folder cannot be written: the copy of the membrane's mesh file, made longer than the
+// file-size limit by a 70 kB comment section (a lower limit would hit OpenMPI's own files first), after
+// config.resolved.toml. The folder is not left behind, and the status says nothing was written.
 TEST(RobustnessOutput, NewFolderIsRemovedWhenItsFirstFileCannotBeWritten) {
   ScratchDir scratch("output");
   const fs::path out = scratch / "out";
-  auto sets = small_membrane_sets(1);
-  sets.push_back("membrane[0].mesh.file=\"" + std::string(70000, 'x') + "\"");
-  const auto r = run_with_file_size_limit(run_args(scenario_file("oscillating_membrane_quick.toml"), out, sets),
-                                          scratch / "run", kLimit);
+  write_gmsh(scratch / "cell.msh", immerse::octahedral_sphere(1), {0.2, 0.2, 0.2});
+  std::ofstream(scratch / "cell.msh", std::ios::app) << "$Comments\n" << std::string(70000, 'x') << "\n$EndComments\n";
+  std::ofstream(scratch / "cell.toml") << file_membrane_toml("cell.msh");
+  const auto r = run_with_file_size_limit(run_args(scratch / "cell.toml", out, small_run_sets(1)), scratch / "run", kLimit);
   expect_one_error_line(r, 2, "immerse: error: ",
-                        "cannot write " + (out / "config.resolved.toml").string() + ": File too large");
+                        "cannot write " + (out / "mesh_membrane0.msh").string() + ": File too large");
   EXPECT_FALSE(fs::exists(out));
 }
 

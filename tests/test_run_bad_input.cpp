@@ -121,6 +121,24 @@ class BadInputTest : public ::testing::TestWithParam<BadInput> {
     mirrored << "7 " << -x << " " << -y << " " << -z;
     *seven = mirrored.str();
     write_lines(dir / "inverted.msh", oct);
+
+    // A membrane read from a file (cell.msh, found from the configuration's folder) and files that do not fit it:
+    // another mesh, the same nodes in other elements, two cells in one file, the cell in millimetres.
+    std::ofstream(dir / "file_mesh.toml") << file_membrane_toml("cell.msh");
+    const Mesh cell = octahedral_sphere(1);
+    write_gmsh(dir / "cell.msh", cell, {0.2, 0.2, 0.2});
+    write_gmsh(dir / "coarse.msh", octahedral_sphere(0), {0.2, 0.2, 0.2});
+    Mesh reordered = cell;
+    std::swap(reordered.elements[0], reordered.elements[1]);
+    write_gmsh(dir / "reordered.msh", reordered, {0.2, 0.2, 0.2});
+    Mesh two = cell;
+    for (const auto& p : cell.nodes) two.nodes.push_back(p + Vec3{2.5, 0, 0});
+    for (auto el : cell.elements) {
+      for (int& n : el) n += static_cast<int>(cell.num_nodes());
+      two.elements.push_back(el);
+    }
+    write_gmsh(dir / "two_cells.msh", two, {0.2, 0.2, 0.2});
+    write_gmsh(dir / "cell_mm.msh", cell, {200, 200, 200});
   }
   static void TearDownTestSuite() { fs::remove_all(suite_dir()); }
 };
@@ -130,7 +148,7 @@ TEST_P(BadInputTest, ExitsWithStatus2AndOneLineBeforeWritingAnything) {
   ScratchDir scratch("bad_input");
   const fs::path out = scratch / "out";
   const fs::path file = b.file.empty() ? scenario_file("oscillating_membrane_quick.toml") : suite_dir() / b.file;
-  auto sets = small_membrane_sets(1);
+  auto sets = b.file == "file_mesh.toml" ? small_run_sets(1) : small_membrane_sets(1);
   for (std::string set : b.sets) {
     if (const auto at = set.find("SUITE"); at != std::string::npos) set.replace(at, 5, suite_dir().string());
     sets.push_back(set);
@@ -170,8 +188,8 @@ INSTANTIATE_TEST_SUITE_P(
                  "is limited to 12000 unknowns and this run has 12294"},
         BadInput{"missing_config", "no_such_file.toml", {}, "", "no_such_file.toml: cannot read: No such file or directory"},
         BadInput{"config_syntax_error", "syntax_error.toml", {}, "", "syntax_error.toml:2"},
-        BadInput{"missing_mesh_file", "", {"membrane[0].mesh.family=\"file\"", "membrane[0].mesh.file=\"no_such.msh\""},
-                 "", "membrane[0].mesh no_such.msh: cannot open the file"},
+        BadInput{"missing_mesh_file", "file_mesh.toml", {"membrane[0].mesh.file=\"no_such.msh\""}, "",
+                 "membrane[0].mesh no_such.msh: cannot open the file"},
         BadInput{"checkpoint_of_other_grid", "", {"grid.nx=8", "grid.ny=8", "grid.nz=8"}, "good/checkpoint.h5",
                  "checkpoint.h5 was written with grid.nx = 16 (on restart only time.end, scenario.kt_end, "
                  "[output] and [solver] keys may change)"},
@@ -224,7 +242,7 @@ INSTANTIATE_TEST_SUITE_P(
         BadInput{"mesh_level_too_fine", "", {"membrane[0].mesh.level=8"}, "",
                  "membrane[0].mesh.level = 8: must be an integer in [0, 7]"},
         BadInput{"membrane_index_gap", "", {"membrane[2].Es=1"}, "", "membrane[2].Es: index 2 given: must be in [0, 1]"},
-        BadInput{"missing_mesh_file_key", "", {"membrane[0].mesh.family=\"file\""}, "",
+        BadInput{"missing_mesh_file_key", "file_mesh.toml", {"membrane[0].mesh.file=\"\""}, "",
                  "membrane[0].mesh.file: must be a Gmsh file name when mesh.family = \"file\""},
         BadInput{"shear_without_walls", "", {"scenario.kind=\"capsule_shear\"", "boundary.z=\"periodic\""}, "",
                  "boundary.z: must be \"wall\" for scenario.kind = \"capsule_shear\""},
@@ -237,15 +255,55 @@ INSTANTIATE_TEST_SUITE_P(
         BadInput{"wall_velocity_set_by_the_shear_kind", "",
                  {"scenario.kind=\"capsule_shear\"", "boundary.z_upper_velocity=[1,0,0]"}, "",
                  "boundary.z_upper_velocity = [1.0, 0.0, 0.0]: scenario.kind = \"capsule_shear\" sets it to "},
-        BadInput{"truncated_mesh", "",
-                 {"membrane[0].mesh.family=\"file\"", "membrane[0].mesh.file=\"SUITE/truncated.msh\""}, "",
+        BadInput{"truncated_mesh", "file_mesh.toml", {"membrane[0].mesh.file=\"SUITE/truncated.msh\""}, "",
                  "truncated.msh: truncated or malformed file while reading $Elements"},
-        BadInput{"inverted_mesh_element", "",
-                 {"membrane[0].mesh.family=\"file\"", "membrane[0].mesh.file=\"SUITE/inverted.msh\""}, "",
+        BadInput{"inverted_mesh_element", "file_mesh.toml", {"membrane[0].mesh.file=\"SUITE/inverted.msh\""}, "",
                  "inverted.msh: element 0 (gmsh id 1) is inverted"},
-        BadInput{"mesh_file_is_a_folder", "",
-                 {"membrane[0].mesh.family=\"file\"", "membrane[0].mesh.file=\"SUITE\""}, "",
+        BadInput{"mesh_file_is_a_folder", "file_mesh.toml", {"membrane[0].mesh.file=\"SUITE\""}, "",
                  "cannot open the file: it is a directory"},
+        // A membrane read from a file: the keys of generated shapes are refused by name, and so are the file keys
+        // of a generated membrane.
+        BadInput{"file_mesh_radius", "file_mesh.toml", {"membrane[0].radius=0.2"}, "",
+                 "membrane[0].radius: does not apply to mesh.family = \"file\" (the file gives the shape; use "
+                 "mesh.scale)"},
+        BadInput{"file_mesh_shape", "file_mesh.toml", {"membrane[0].shape=\"sphere\""}, "",
+                 "membrane[0].shape: does not apply to mesh.family = \"file\""},
+        BadInput{"file_mesh_semi_axes", "file_mesh.toml", {"membrane[0].semi_axes=[0.25,0.22,0.2]"}, "",
+                 "membrane[0].semi_axes: does not apply to mesh.family = \"file\""},
+        BadInput{"file_mesh_aspect_ratio", "file_mesh.toml", {"membrane[0].aspect_ratio=0.5"}, "",
+                 "membrane[0].aspect_ratio: does not apply to mesh.family = \"file\""},
+        BadInput{"file_mesh_R0", "file_mesh.toml", {"membrane[0].R0=0.2"}, "",
+                 "membrane[0].R0: does not apply to mesh.family = \"file\""},
+        BadInput{"file_mesh_level", "file_mesh.toml", {"membrane[0].mesh.level=1"}, "",
+                 "membrane[0].mesh.level: does not apply to mesh.family = \"file\" (the file gives the nodes)"},
+        BadInput{"file_mesh_reference_radius", "file_mesh.toml", {"membrane[0].reference_radius=0.2"}, "",
+                 "membrane[0].reference_radius: does not apply unless reference = \"sphere\""},
+        BadInput{"reference_file_without_reference_file_kind", "file_mesh.toml",
+                 {"membrane[0].mesh.reference_file=\"SUITE/cell.msh\""}, "",
+                 "membrane[0].mesh.reference_file: does not apply unless reference = \"file\""},
+        BadInput{"generated_mesh_file", "", {"membrane[0].mesh.file=\"SUITE/cell.msh\""}, "",
+                 "membrane[0].mesh.file: does not apply unless mesh.family = \"file\""},
+        BadInput{"generated_mesh_scale", "", {"membrane[0].mesh.scale=1e-6"}, "",
+                 "membrane[0].mesh.scale: does not apply unless mesh.family = \"file\""},
+        BadInput{"generated_reference_file", "", {"membrane[0].reference=\"file\""}, "",
+                 "membrane[0].reference = \"file\": must be \"initial\" or \"sphere\" unless mesh.family = "
+                 "\"file\""},
+        BadInput{"reference_file_missing", "file_mesh.toml", {"membrane[0].reference=\"file\""}, "",
+                 "membrane[0].mesh.reference_file: must be a Gmsh file name when reference = \"file\""},
+        BadInput{"reference_file_other_node_count", "file_mesh.toml",
+                 {"membrane[0].reference=\"file\"", "membrane[0].mesh.reference_file=\"SUITE/coarse.msh\""}, "",
+                 "membrane[0].mesh.reference_file: has 18 nodes, mesh.file 66 nodes: must be the mesh of mesh.file in "
+                 "another shape (the same nodes and elements)"},
+        BadInput{"reference_file_other_elements", "file_mesh.toml",
+                 {"membrane[0].reference=\"file\"", "membrane[0].mesh.reference_file=\"SUITE/reordered.msh\""}, "",
+                 "membrane[0].mesh.reference_file: element 0 joins nodes "},
+        BadInput{"two_cells_in_one_file", "file_mesh.toml", {"membrane[0].mesh.file=\"SUITE/two_cells.msh\""}, "",
+                 "two_cells.msh: holds 2 separate closed surfaces: must be one (give each its own [[membrane]] and "
+                 "file)"},
+        BadInput{"mesh_in_another_unit", "file_mesh.toml", {"membrane[0].mesh.file=\"SUITE/cell_mm.msh\""}, "",
+                 "membrane[0] lies outside the box: node 0 at (200.5, 0.5, 0.5) is outside the fluid domain: beyond "
+                 "the wall x = 1 (is the mesh file in another unit? mesh.scale converts it to metres, e.g. 1e-6 for "
+                 "micrometres)"},
         BadInput{"frame_offered_as_checkpoint", "", {}, "good/fields_000000.h5",
                  "fields_000000.h5 is not an immerse checkpoint (no format version)"},
         BadInput{"unknown_petsc_option", "", {"solver.petsc_options=\"-ksp_gmres_restartx 10\""}, "",
@@ -267,35 +325,13 @@ TEST(BadInputRestart, ChangedMeshFileIsRefused) {
   fs::remove_all(dir);
   fs::create_directories(dir);
   const Mesh sphere = octahedral_sphere(1);
-  auto write_msh = [&](double radius) {
-    std::ofstream f(dir / "cell.msh");
-    f.precision(17);
-    f << "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n$Nodes\n" << sphere.nodes.size() << "\n";
-    for (std::size_t i = 0; i < sphere.nodes.size(); ++i)
-      f << i + 1 << " " << radius * sphere.nodes[i].x << " " << radius * sphere.nodes[i].y << " "
-        << radius * sphere.nodes[i].z << "\n";
-    f << "$EndNodes\n$Elements\n" << sphere.elements.size() << "\n";
-    for (std::size_t e = 0; e < sphere.elements.size(); ++e) {
-      f << e + 1 << " 9 2 0 1";
-      for (int n : sphere.elements[e]) f << " " << n + 1;
-      f << "\n";
-    }
-    f << "$EndElements\n";
-  };
-  auto sets = [&](int steps) {
-    auto s = small_membrane_sets(steps);
-    s.insert(s.end(), {"membrane[0].mesh.family=\"file\"", "membrane[0].mesh.file=\"" + (dir / "cell.msh").string() + "\"",
-                       "membrane[0].reference=\"initial\""});
-    return s;
-  };
-  write_msh(0.2);
-  const auto first = run_immerse(run_args(scenario_file("oscillating_membrane_quick.toml"), dir / "a", sets(1)),
-                                 dir / "first");
+  std::ofstream(dir / "cell.toml") << file_membrane_toml("cell.msh");
+  write_gmsh(dir / "cell.msh", sphere, {0.2, 0.2, 0.2});
+  const auto first = run_immerse(run_args(dir / "cell.toml", dir / "a", small_run_sets(1)), dir / "first");
   ASSERT_EQ(first.status, 0) << first.err;
-  write_msh(0.21);
-  const auto again = run_immerse(run_args(scenario_file("oscillating_membrane_quick.toml"), dir / "a", sets(2),
-                                          dir / "a" / "checkpoint.h5"),
-                                 dir / "again");
+  write_gmsh(dir / "cell.msh", sphere, {0.21, 0.21, 0.21});
+  const auto again =
+      run_immerse(run_args(dir / "cell.toml", dir / "a", small_run_sets(2), dir / "a" / "checkpoint.h5"), dir / "again");
   EXPECT_EQ(again.status, 2) << again.err;
   EXPECT_NE(again.err.find("the reference state of membrane[0] differs"), std::string::npos) << again.err;
   fs::remove_all(dir);

@@ -15,6 +15,8 @@
 #include <string>
 #include <vector>
 
+#include "immerse/membrane/Mesh.hpp"
+
 extern char** environ;
 
 namespace immerse::testing {
@@ -148,11 +150,43 @@ inline RunResult run_immerse(const std::vector<std::string>& args, const fs::pat
   return {status, p.out(), p.err()};
 }
 
-/// `--set` arguments turning oscillating_membrane_quick.toml into a small run of `steps` steps of dt (default 0.125;
-/// 16^3 grid, unit box, octahedral level-1 membrane of 66 nodes).
-inline std::vector<std::string> small_membrane_sets(int steps, double dt = 0.125) {
-  return {"grid.nx=16", "grid.ny=16", "grid.nz=16", "membrane[0].mesh.level=1", "time.dt=" + std::to_string(dt),
+/// `--set` arguments turning oscillating_membrane_quick.toml (or file_membrane_toml) into a small run of `steps` steps
+/// of dt (default 0.125; 16^3 grid, unit box) whose membrane is not generated.
+inline std::vector<std::string> small_run_sets(int steps, double dt = 0.125) {
+  return {"grid.nx=16", "grid.ny=16", "grid.nz=16", "time.dt=" + std::to_string(dt),
           "time.end=" + std::to_string(dt * steps), "output.fields_every=0", "output.checkpoint_every=0"};
+}
+
+/// small_run_sets with the generated octahedral level-1 membrane of 66 nodes.
+inline std::vector<std::string> small_membrane_sets(int steps, double dt = 0.125) {
+  auto sets = small_run_sets(steps, dt);
+  sets.insert(sets.begin() + 3, "membrane[0].mesh.level=1");
+  return sets;
+}
+
+/// Writes `mesh` as a Gmsh 2.2 file of 6-node triangles, the coordinates of its nodes multiplied by `scale` (x, y, z).
+inline void write_gmsh(const fs::path& path, const Mesh& mesh, const Vec3& scale = {1, 1, 1}) {
+  std::ofstream f(path);
+  f.precision(17);
+  f << "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n$Nodes\n" << mesh.nodes.size() << "\n";
+  for (std::size_t i = 0; i < mesh.nodes.size(); ++i)
+    f << i + 1 << " " << scale.x * mesh.nodes[i].x << " " << scale.y * mesh.nodes[i].y << " "
+      << scale.z * mesh.nodes[i].z << "\n";
+  f << "$EndNodes\n$Elements\n" << mesh.elements.size() << "\n";
+  for (std::size_t e = 0; e < mesh.elements.size(); ++e) {
+    f << e + 1 << " 9 2 0 1";
+    for (int n : mesh.elements[e]) f << " " << n + 1;
+    f << "\n";
+  }
+  f << "$EndElements\n";
+}
+
+/// oscillating_membrane_quick.toml with its [[membrane]] read from the Gmsh file `mesh` (a relative name is taken from
+/// the configuration's folder), centred in the unit box, instead of generated; `extra`: further lines of the entry.
+inline std::string file_membrane_toml(const std::string& mesh, const std::string& extra = "") {
+  const std::string base = read_text(scenario_file("oscillating_membrane_quick.toml"));
+  return base.substr(0, base.find("[[membrane]]")) + "[[membrane]]\nmesh.family = \"file\"\nmesh.file = \"" + mesh +
+         "\"\ncenter = [0.5, 0.5, 0.5]\nEs = 0.1\n" + extra;
 }
 
 /// The command line `run FILE --out DIR --set ...`.

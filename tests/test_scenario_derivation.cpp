@@ -58,7 +58,7 @@ std::string with_kind(const char* base, const std::string& kind) {
   return t;
 }
 
-std::string error_of(const std::string& text, const std::vector<std::string>& sets) {
+std::string error_of(const std::string& text, const std::vector<std::string>& sets = {}) {
   try {
     resolve(text, sets);
   } catch (const InputError& e) {
@@ -223,8 +223,52 @@ center = [2.0, 1.0, 1.0]
   EXPECT_TRUE(c.given("membrane[1].center"));
   EXPECT_EQ(c.derivation("membrane[1].center"), "");
   // A file mesh is placed where its file puts it (center is a displacement there).
-  const io::Config f = resolve(text, {"membrane[0].mesh.family=\"file\""});
-  EXPECT_EQ(f.get<Vec3>("membrane[0].center").x, 0.0);
+  const io::Config g = resolve("[[membrane]]\nmesh.family = \"file\"\nmesh.file = \"cell.msh\"\n");
+  EXPECT_EQ(g.get<Vec3>("membrane[0].center").x, 0.0);
+  EXPECT_EQ(g.derivation("membrane[0].center"), "");
+}
+
+// Keys that do not apply to a membrane: refused by name when given, left out of the written configuration otherwise,
+// which reads back as it was written.
+TEST(MembraneKeys, KeysThatDoNotApplyAreRefusedWhenGivenAndLeftOutOtherwise) {
+  const std::string file = "[[membrane]]\nmesh.family = \"file\"\nmesh.file = \"cell.msh\"\n";
+  EXPECT_EQ(error_of(file, {"membrane[0].radius=1e-6"}),
+            "membrane[0].radius: does not apply to mesh.family = \"file\" (the file gives the shape; use mesh.scale)");
+  EXPECT_EQ(error_of(file, {"membrane[0].mesh.level=2"}),
+            "membrane[0].mesh.level: does not apply to mesh.family = \"file\" (the file gives the nodes)");
+  EXPECT_EQ(error_of(file, {"membrane[0].reference_radius=1e-6"}),
+            "membrane[0].reference_radius: does not apply unless reference = \"sphere\"");
+  EXPECT_EQ(error_of(file, {"membrane[0].mesh.reference_file=\"rest.msh\""}),
+            "membrane[0].mesh.reference_file: does not apply unless reference = \"file\"");
+  EXPECT_EQ(error_of("[[membrane]]\nradius = 1e-6\n", {"membrane[0].mesh.scale=1e-6"}),
+            "membrane[0].mesh.scale: does not apply unless mesh.family = \"file\"");
+  EXPECT_EQ(error_of("[[membrane]]\nreference = \"file\"\n"),
+            "membrane[0].reference = \"file\": must be \"initial\" or \"sphere\" unless mesh.family = \"file\"");
+  EXPECT_EQ(error_of(file, {"membrane[0].reference=\"sphere\"", "membrane[0].reference_radius=1e-6"}), "");
+
+  const io::Config c = resolve(file);
+  const std::string toml = c.to_toml_string();
+  EXPECT_TRUE(c.left_out("membrane[0].radius"));
+  EXPECT_FALSE(c.left_out("membrane[0].mesh.scale"));
+  EXPECT_EQ(toml.find("\nradius = "), std::string::npos);
+  EXPECT_EQ(toml.find("\nmesh.level = "), std::string::npos);
+  EXPECT_NE(toml.find("# left out, as they do not apply to this entry: shape, radius, semi_axes, aspect_ratio, "
+                      "inclination, R0, reference_radius, mesh.level, mesh.reference_file\n"),
+            std::string::npos);
+  EXPECT_EQ(resolve(toml).to_toml_string(), toml);
+  // A generated mesh: the file keys are left out.
+  const std::string generated = resolve("[[membrane]]\nradius = 1e-6\n").to_toml_string();
+  EXPECT_EQ(generated.find("\nmesh.file = "), std::string::npos);
+  EXPECT_EQ(generated.find("\nmesh.scale = "), std::string::npos);
+  EXPECT_NE(generated.find("\nradius = "), std::string::npos);
+}
+
+// In the shear scenarios the radius is the length a of the groups G and Re, also for a mesh read from a file.
+TEST(MembraneKeys, TheShearScenariosTakeTheRadiusOfAFileMesh) {
+  const std::string text = std::string(kShear) + "mesh.family = \"file\"\nmesh.file = \"cell.msh\"\n";
+  EXPECT_EQ(error_of(text), "");
+  EXPECT_FALSE(resolve(text).left_out("membrane[0].radius"));
+  EXPECT_TRUE(resolve(text).left_out("membrane[0].shape"));
 }
 
 TEST(CustomKind, GivenAndDerivedDoNotChangeEquality) {

@@ -54,6 +54,17 @@ void Config::derive(const std::string& key, const std::string& value_text, const
   const_cast<Config*>(c)->derivations_[std::string(k)] = how;
 }
 
+void Config::leave_out(std::string_view key) {
+  const auto [c, k] = locate(key);
+  c->value(k);  // declared
+  const_cast<Config*>(c)->left_out_.emplace(k);
+}
+
+bool Config::left_out(std::string_view key) const {
+  const auto [c, k] = locate(key);
+  return c->left_out_.contains(k);
+}
+
 const ConfigValue& Config::value(std::string_view key) const {
   const auto [c, k] = locate(key);
   const auto it = c->values_.find(k);
@@ -135,7 +146,12 @@ void Config::write_toml(std::string& out, const std::string& section) const {
     out += written_key + " = " + format_toml(values_.find(k.key)->second) + "\n";
   };
   if (!section.empty()) {
-    for (const auto& k : schema_->keys()) line(k, k.key);
+    std::string omitted;
+    for (const auto& k : schema_->keys()) {
+      if (left_out_.contains(k.key)) omitted += (omitted.empty() ? "" : ", ") + k.key;
+      else line(k, k.key);
+    }
+    if (!omitted.empty()) out += "# left out, as they do not apply to this entry: " + omitted + "\n";
     return;
   }
   std::vector<std::string> sections;

@@ -32,7 +32,7 @@ class Config {
   const Config& entry(std::string_view name, std::size_t i) const;
 
   /// The resolved configuration as TOML, each key preceded by its doc string, allowed values and default.
-  /// Parsing it with the same schema gives back an equal Config.
+  /// Parsing it with the same schema gives back an equal Config, up to the keys left out (leave_out).
   std::string to_toml_string() const;
   /// Writes to_toml_string() to `path` atomically (e.g. DIR/config.resolved.toml).
   void save(const std::filesystem::path& path) const;
@@ -45,6 +45,11 @@ class Config {
   /// Sets a key to a derived value (TOML text, as an override) and records how it was derived; the key does not
   /// count as given. InputError ("KEY = VALUE: must be ... (derived: HOW)") if the value is out of range.
   void derive(const std::string& key, const std::string& value_text, const std::string& how);
+
+  /// Marks a key of a [[table]] entry that does not apply (as "membrane[0].radius" to a mesh read from a file):
+  /// to_toml_string() names it in a comment instead of writing a value that would read as if it applied.
+  void leave_out(std::string_view key);
+  bool left_out(std::string_view key) const;
 
   const ConfigSchema& schema() const { return *schema_; }
   /// Equal values (whether given or derived does not count).
@@ -65,6 +70,7 @@ class Config {
   std::map<std::string, std::vector<Config>, std::less<>> tables_;
   std::set<std::string, std::less<>> given_;                        // keys of this table the user gave
   std::map<std::string, std::string, std::less<>> derivations_;     // derived keys of this table: how
+  std::set<std::string, std::less<>> left_out_;                     // keys of this table that do not apply
 };
 
 template <> double Config::get<double>(std::string_view key) const;

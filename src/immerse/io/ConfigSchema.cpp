@@ -112,6 +112,11 @@ ConfigSchema& ConfigSchema::add_string(std::string key, std::string def, std::ve
                                        std::string doc) {
   return add({std::move(key), KeySpec::Kind::String, std::move(def), Range::any(), std::move(choices), std::move(doc)});
 }
+ConfigSchema& ConfigSchema::add_path(std::string key, std::string doc) {
+  KeySpec spec{std::move(key), KeySpec::Kind::String, std::string(), Range::any(), {}, std::move(doc)};
+  spec.path = true;
+  return add(std::move(spec));
+}
 ConfigSchema& ConfigSchema::add_double_list(std::string key, std::vector<double> def, Range range, std::string doc) {
   return add({std::move(key), KeySpec::Kind::DoubleList, std::move(def), range, {}, std::move(doc)});
 }
@@ -266,13 +271,18 @@ class ConfigResolver {
     return v;
   }
 
+  // `folder`: of the configuration file, against which relative file names are resolved (empty: none).
   static void walk(const toml::table& t, const std::string& prefix, const ConfigSchema& s, Config& out,
-                   const std::string& display, const std::string& source) {
+                   const std::string& display, const std::string& source, const std::filesystem::path& folder) {
     for (const auto& [k, node] : t) {
       const std::string key = prefix + std::string(k.str());
       const std::string name = display + key;
       if (const KeySpec* spec = s.find(key)) {
-        out.values_[key] = convert(*spec, node, name, where(source, node.source()), given(node));
+        ConfigValue v = convert(*spec, node, name, where(source, node.source()), given(node));
+        if (const auto* file = std::get_if<std::string>(&v);
+            spec->path && !folder.empty() && !file->empty() && std::filesystem::path(*file).is_relative())
+          v = (folder / *file).lexically_normal().string();
+        out.values_[key] = std::move(v);
         out.given_.insert(key);
       } else if (const auto* ta = s.find_table_array(key)) {
         const toml::array* a = node.as_array();
@@ -283,11 +293,11 @@ class ConfigResolver {
         entries.clear();
         for (std::size_t i = 0; i < a->size(); ++i) {
           Config e(ta->entry);
-          walk(*a->get(i)->as_table(), "", *ta->entry, e, name + "[" + std::to_string(i) + "].", source);
+          walk(*a->get(i)->as_table(), "", *ta->entry, e, name + "[" + std::to_string(i) + "].", source, folder);
           entries.push_back(std::move(e));
         }
       } else if (node.is_table() && declares_prefix(s, key)) {
-        walk(*node.as_table(), key + ".", s, out, display, source);
+        walk(*node.as_table(), key + ".", s, out, display, source, folder);
       } else {
         // Name an unknown table by its first key ([fluidd] mu = 1 -> fluidd.mu) so that it can be matched.
         std::string full = key;
@@ -392,6 +402,11 @@ void ConfigSchema::apply_derived(Config& config, std::span<const std::string> as
 
 Config ConfigSchema::parse_string(std::string_view toml, const std::string& source,
                                   std::span<const std::string> overrides) const {
+  return parse(toml, source, {}, overrides);
+}
+
+Config ConfigSchema::parse(std::string_view toml, const std::string& source, const std::filesystem::path& folder,
+                           std::span<const std::string> overrides) const {
   toml::table table;
   try {
     table = toml::parse(toml, source);
@@ -399,7 +414,7 @@ Config ConfigSchema::parse_string(std::string_view toml, const std::string& sour
     throw InputError(where(source, e.source()) + ": " + one_line(std::string(e.description())));
   }
   Config cfg = defaults();
-  ConfigResolver::walk(table, "", *this, cfg, "", source);
+  ConfigResolver::walk(table, "", *this, cfg, "", source, folder);
   apply_overrides(cfg, overrides);
   ConfigResolver::check_counts(*this, cfg, "config " + source);
   return cfg;
@@ -430,7 +445,7 @@ Config ConfigSchema::parse_file(const std::filesystem::path& file, std::span<con
     }
   }
   ::close(fd);
-  return parse_string(text, file.string(), overrides);
+  return parse(text, file.string(), std::filesystem::absolute(file).parent_path(), overrides);
 }
 
 void ConfigSchema::print_help(std::ostream& os) const {

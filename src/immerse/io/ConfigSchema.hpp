@@ -64,6 +64,7 @@ struct KeySpec {
   Range range = Range::any();
   std::vector<std::string> choices;  // allowed strings (empty: any string)
   std::string doc;
+  bool path = false;  // a file name: a relative one in a configuration file is taken from that file's folder
 
   /// What is allowed, as it reads after "must be": "a finite number > 0", "one of \"a\", \"b\"", ...
   std::string allowed() const;
@@ -77,6 +78,9 @@ class ConfigSchema {
   ConfigSchema& add_bool(std::string key, bool def, std::string doc);
   /// `choices` empty: any string.
   ConfigSchema& add_string(std::string key, std::string def, std::vector<std::string> choices, std::string doc);
+  /// A file name (a string): relative names in a configuration file are resolved against the file's folder by
+  /// parse_file; elsewhere (--set, parse_string) they stay as given, relative to the current folder.
+  ConfigSchema& add_path(std::string key, std::string doc);
   /// A list of numbers, each within `range`.
   ConfigSchema& add_double_list(std::string key, std::vector<double> def, Range range, std::string doc);
   /// Three numbers [x, y, z], each within `range`.
@@ -90,7 +94,8 @@ class ConfigSchema {
   static constexpr std::size_t kMaxFileBytes = std::size_t{1} << 20;
 
   /// Reads and validates a TOML file, then applies the overrides ("key=value", value in TOML syntax; string
-  /// keys also take bare text). Throws InputError on any bad input.
+  /// keys also take bare text). Relative file names (add_path) written in the file become names under its folder.
+  /// Throws InputError on any bad input.
   Config parse_file(const std::filesystem::path& file, std::span<const std::string> overrides = {}) const;
   /// As parse_file, from TOML text; `source` names it in messages ("config <source>:line:col: ...").
   Config parse_string(std::string_view toml, const std::string& source,
@@ -117,6 +122,8 @@ class ConfigSchema {
 
  private:
   ConfigSchema& add(KeySpec spec);
+  Config parse(std::string_view toml, const std::string& source, const std::filesystem::path& folder,
+               std::span<const std::string> overrides) const;
   void check_new_name(const std::string& name) const;
 
   std::vector<KeySpec> keys_;

@@ -24,6 +24,13 @@ bool OutputFolder::is_run_file(const std::string& name) {
   for (const char* n : {"config.resolved.toml", "diagnostics.csv", "diagnostics.columns.csv", "stretch.csv",
                         "stretch.columns.csv", "checkpoint.h5", "membranes.xdmf", "fluid.xdmf"})
     if (name == n) return true;
+  // mesh_membraneN.msh, mesh_membraneN_reference.msh: the copies of the mesh files
+  for (const std::string tail : {".msh", "_reference.msh"}) {
+    const std::string head = "mesh_membrane";
+    if (name.size() > head.size() + tail.size() && name.rfind(head, 0) == 0 && name.ends_with(tail) &&
+        all_digits(name.substr(0, name.size() - tail.size()), head.size()))
+      return true;
+  }
   // fields_NNNNNN.h5 (at least six digits)
   const std::string head = "fields_", tail = ".h5";
   if (name.size() < head.size() + 6 + tail.size() || name.rfind(head, 0) != 0 ||

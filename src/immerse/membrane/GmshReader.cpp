@@ -38,7 +38,9 @@ class Parser {
   Mesh parse() {
     std::string line;
     bool have_format = false, have_nodes = false, have_elements = false;
-    while (std::getline(in_, line)) {
+    for (bool first = true; std::getline(in_, line); first = false) {
+      // A UTF-8 byte-order mark (written by some editors) is not part of the first line.
+      if (first && line.rfind("\xEF\xBB\xBF", 0) == 0) line.erase(0, 3);
       line = trim(line);
       if (line == "$MeshFormat") {
         read_format();

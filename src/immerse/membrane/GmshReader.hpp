@@ -1,5 +1,5 @@
 #pragma once
-// Reads a closed membrane surface from a Gmsh mesh file, ASCII format 2.2 or 4.1.
+// Reads a closed membrane surface from a Gmsh mesh file, ASCII format 2.2 or 4.1 (a UTF-8 byte-order mark allowed).
 // Surface elements: type 9 (6-node triangle; Gmsh's order v0 v1 v2 m01 m12 m20 is ours) and type 2 (3-node
 // triangle, promoted to a quadratic element with straight-edge midpoints, shared with a neighbouring type-9
 // element's mid-side node when there is one). Other element types (points, lines, ...) are ignored and so are

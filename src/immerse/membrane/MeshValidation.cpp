@@ -106,6 +106,23 @@ void check_edges(const Mesh& mesh, const Namer& name) {
   if (!defects.empty()) name.fail(std::min_element(defects.begin(), defects.end())->second);
 }
 
+// Elements sharing a vertex belong to one surface; a Gmsh file holding two cells is two surfaces.
+void check_one_surface(const Mesh& mesh, const Namer& name) {
+  std::vector<std::size_t> parent(mesh.num_nodes());
+  for (std::size_t n = 0; n < parent.size(); ++n) parent[n] = n;
+  const auto root = [&](std::size_t n) {
+    while (parent[n] != n) n = parent[n] = parent[parent[n]];
+    return n;
+  };
+  for (const auto& el : mesh.elements)
+    for (int k = 1; k < 6; ++k) parent[root(std::size_t(el[k]))] = root(std::size_t(el[0]));
+  std::size_t surfaces = 0;
+  for (std::size_t n = 0; n < parent.size(); ++n) surfaces += root(n) == n;
+  if (surfaces > 1)
+    name.fail("holds " + std::to_string(surfaces) +
+              " separate closed surfaces: must be one (give each its own [[membrane]] and file)");
+}
+
 }  // namespace
 
 void validate_closed_mesh(const Mesh& mesh, const std::string& label, const MeshIds& ids) {
@@ -113,6 +130,7 @@ void validate_closed_mesh(const Mesh& mesh, const std::string& label, const Mesh
   check_nodes_and_indices(mesh, name);
   check_element_shapes(mesh, name);
   check_edges(mesh, name);
+  check_one_surface(mesh, name);
   const double v = volume(mesh, mesh.nodes);
   if (!(v > 0))
     name.fail("encloses volume " + std::to_string(v) + ": elements must be counter-clockwise seen from outside");

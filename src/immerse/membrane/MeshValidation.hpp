@@ -6,6 +6,7 @@
 //   at a node or quadrature point);
 //   every vertex edge shared by exactly two elements (one: open surface; more: non-manifold), traversed
 //   in opposite directions by them (consistent orientation) and with the same mid-side node;
+//   one connected surface (a file of two cells is refused, naming the count);
 //   positive enclosed volume (elements counter-clockwise seen from outside).
 // Failures throw a one-line InputError: "mesh <label>: element 17 (gmsh id 123) has zero area".
 #include <cstddef>

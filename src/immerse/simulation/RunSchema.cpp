@@ -14,22 +14,35 @@ ConfigSchema membrane_schema() {
   m.add_string("shape", "sphere", {"sphere", "ellipsoid", "oblate", "rbc"},
                "initial shape: sphere (radius), ellipsoid (semi_axes, eq. 43), oblate spheroid (radius of the "
                "equal-volume sphere, aspect_ratio, inclination; §4.2.2) or biconcave red blood cell (eq. 45, R0)");
-  m.add_double("radius", 1e-6, Range::positive(), "sphere radius / radius of the equal-volume sphere (m)");
+  m.add_double("radius", 1e-6, Range::positive(),
+               "sphere radius / radius of the equal-volume sphere (m); with mesh.family = \"file\" only in the shear "
+               "scenarios, as the radius a of their groups G and Re");
   m.add_vec3("semi_axes", {1e-6, 1e-6, 1e-6}, Range::positive(), "ellipsoid semi-axes along x, y, z (m)");
   m.add_double("aspect_ratio", 1.0, Range::open_closed(0, 1), "oblate spheroid: short over long axis b/a");
   m.add_double("inclination", 0.0, Range::closed(-3.2, 3.2), "oblate spheroid: angle of the long axis from x towards z (rad)");
   m.add_double("R0", 3.91e-6, Range::positive(), "red blood cell radius R0 of eq. (45) (m)");
-  m.add_string("reference", "initial", {"initial", "sphere"},
-               "stress-free reference configuration: the initial shape, or a sphere of reference_radius (§4.1)");
+  m.add_string("reference", "initial", {"initial", "sphere", "file"},
+               "stress-free reference configuration: the initial shape, a sphere of reference_radius (§4.1), or "
+               "the shape of mesh.reference_file (mesh.family = \"file\")");
   m.add_double("reference_radius", 1e-6, Range::positive(), "radius of the reference sphere when reference = \"sphere\" (m)");
   m.add_vec3("center", {0, 0, 0}, Range::any(), "position of the shape's centre (m)");
   m.add_vec3("rotation_axis", {0, 0, 1}, Range::any(), "axis of the rigid rotation applied to the shape");
   m.add_double("rotation_angle", 0.0, Range::closed(-7, 7), "angle of the rigid rotation (rad)");
   m.add_string("mesh.family", "icosahedral", {"icosahedral", "octahedral", "file"},
                "subdivided icosahedron (10*4^(l+1)+2 nodes) or octahedron (4*4^(l+1)+2 nodes) mapped onto the shape, "
-               "or a Gmsh file (mesh.file, 6- or 3-node triangles: the initial shape itself, placed by center and rotation)");
+               "or a Gmsh file (mesh.file, 6- or 3-node triangles: the initial shape itself, scaled by mesh.scale and "
+               "placed by center and rotation; shape, radius, semi_axes, aspect_ratio, inclination, R0 and mesh.level "
+               "do not apply)");
   m.add_int("mesh.level", 3, Range::closed(0, 7), "subdivision level (icosahedral 4: 10,242 nodes; octahedral 5: 16,386)");
-  m.add_string("mesh.file", "", {}, "Gmsh .msh file when mesh.family = \"file\"");
+  m.add_path("mesh.file",
+             "Gmsh .msh file of one closed surface when mesh.family = \"file\"; a relative name is taken from the "
+             "configuration file's folder (given with --set: from the current folder); the run folder keeps a copy");
+  m.add_double("mesh.scale", 1.0, Range::positive(),
+               "mesh.family = \"file\": metres per length unit of the file (1e-6 for a mesh in micrometres), applied "
+               "before center and rotation");
+  m.add_path("mesh.reference_file",
+             "reference = \"file\": Gmsh .msh file of the stress-free shape, the same nodes and elements as mesh.file "
+             "in another shape; scaled and placed as mesh.file, found and copied as it is");
   m.add_string("law", "neo_hookean", {"neo_hookean", "yeoh", "skalak"}, "strain energy: eq. (22), (23) or (24)");
   m.add_double("Es", 1e-6, Range::positive(), "neo-Hookean surface elastic modulus E_s of eq. (22) (N/m)");
   m.add_double("C10", 2.5e-6, Range::positive(), "Yeoh C10 of eq. (23) (N/m)");

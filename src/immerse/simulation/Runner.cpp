@@ -11,6 +11,7 @@
 #include <iomanip>
 #include <functional>
 #include <iostream>
+#include <map>
 #include <optional>
 #include <sstream>
 
@@ -191,6 +192,38 @@ void check_memory(const io::Config& c) {
   }
 }
 
+// The mesh files of a run, to be copied into its folder, and the configuration naming the copies
+// (mesh_membraneN.msh, mesh_membraneN_reference.msh, N the first membrane using the file), so that the folder runs
+// again as it is. A file several membranes use is copied once.
+struct MeshCopies {
+  io::Config config;
+  std::vector<std::pair<std::string, std::string>> files;  // name in the run folder, content
+};
+
+MeshCopies mesh_copies(const io::Config& config) {
+  MeshCopies copies{config, {}};
+  std::map<std::filesystem::path, std::string> copy_of;  // the source file -> the name of its copy
+  for (std::size_t i = 0; i < config.count("membrane"); ++i)
+    for (const std::string key : {"mesh.file", "mesh.reference_file"}) {
+      const std::string k = "membrane[" + std::to_string(i) + "]." + key;
+      const std::string source = config.get<std::string>(k);
+      if (config.left_out(k) || source.empty()) continue;
+      std::error_code ec;
+      const std::filesystem::path full = std::filesystem::weakly_canonical(std::filesystem::absolute(source), ec);
+      const auto [it, added] = copy_of.emplace(
+          full, "mesh_membrane" + std::to_string(i) + (key == "mesh.file" ? "" : "_reference") + ".msh");
+      if (added) {
+        std::ifstream in(source, std::ios::binary);
+        std::ostringstream content;
+        content << in.rdbuf();
+        if (!in || ec) throw InputError(k + " " + source + ": cannot read the file to copy it into the run folder");
+        copies.files.emplace_back(it->second, content.str());
+      }
+      copies.config.derive(k, io::format_toml(it->second), "the copy of " + full.string() + " in the run folder");
+    }
+  return copies;
+}
+
 }  // namespace
 
 void print_config_help(std::ostream& out) { run_schema().print_help(out); }
@@ -238,6 +271,7 @@ int run_command(const RunOptions& options, std::ostream& out, std::ostream& err)
   } else if (sweep) {
     sweep->start(sim, 0);
   }
+  const MeshCopies copies = mesh_copies(config);
   const int diagnostics_every = config.get<int>("output.diagnostics_every");
   const int fields_every = config.get<int>("output.fields_every");
   const int checkpoint_every = config.get<int>("output.checkpoint_every");
@@ -297,11 +331,12 @@ int run_command(const RunOptions& options, std::ostream& out, std::ostream& err)
 
     out << "# immerse " << provenance.version << " (commit " << provenance.commit << "): " << options.file.string()
         << " -> " << dir.string() << "\n";
-    for (const auto& line : derived_values(config)) out << "# derived: " << line << "\n";
+    for (const auto& line : derived_values(copies.config)) out << "# derived: " << line << "\n";
     if (options.verbose)
-      out << "# resolved configuration (saved as config.resolved.toml)\n" << config.to_toml_string();
+      out << "# resolved configuration (saved as config.resolved.toml)\n" << copies.config.to_toml_string();
     out << std::flush;
-    io::AtomicFile::write(dir / "config.resolved.toml", provenance.toml_comments() + config.to_toml_string());
+    io::AtomicFile::write(dir / "config.resolved.toml", provenance.toml_comments() + copies.config.to_toml_string());
+    for (const auto& [name, content] : copies.files) io::AtomicFile::write(dir / name, content);
     io::AtomicFile::write(dir / "diagnostics.columns.csv", column_table(column_info));
     if (sweep) io::AtomicFile::write(dir / "stretch.columns.csv", column_table(kStretchColumns));
 

@@ -24,8 +24,13 @@
 
 namespace immerse {
 
-/// The configuration with the scenario's derived values written into their keys (for printing and saving).
+/// The configuration with the scenario's derived values written into their keys (for printing and saving). A key of a
+/// [[membrane]] entry that does not apply to it (radius to a mesh read from a file, mesh.file to a generated one, ...)
+/// is refused when the user gave it and left out of the written configuration otherwise.
 io::Config apply_scenario(const io::Config& config);
+
+/// Marks the keys of each [[membrane]] entry that do not apply to it as left out (io::Config::leave_out).
+void leave_out_inapplicable(io::Config& config);
 
 /// rbc_channel: the centres of the 32 cells (see above).
 std::vector<Vec3> channel_cell_centres(const io::Config& config);

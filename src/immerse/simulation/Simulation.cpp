@@ -1,5 +1,6 @@
 #include "immerse/simulation/Simulation.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <sstream>
@@ -15,6 +16,7 @@
 #include "immerse/membrane/Skalak.hpp"
 #include "immerse/membrane/Yeoh.hpp"
 #include "immerse/simulation/MembraneClearance.hpp"
+#include "immerse/simulation/Scenario.hpp"
 #include "immerse/timestep/DenseBfgs.hpp"
 
 namespace immerse {
@@ -99,6 +101,35 @@ MaterialLaw law_of(const io::Config& m) {
 
 std::string membrane_name(std::size_t m) { return "membrane[" + std::to_string(m) + "]"; }
 
+// mesh.reference_file must be mesh.file in another shape: the same nodes joined into the same elements.
+void check_same_elements(const Mesh& reference, const Mesh& mesh) {
+  const std::string same = ": must be the mesh of mesh.file in another shape (the same nodes and elements)";
+  const auto count = [](std::size_t n, const char* what) { return std::to_string(n) + " " + what; };
+  if (reference.num_nodes() != mesh.num_nodes())
+    throw InputError("mesh.reference_file: has " + count(reference.num_nodes(), "nodes") + ", mesh.file " +
+                     count(mesh.num_nodes(), "nodes") + same);
+  if (reference.num_elements() != mesh.num_elements())
+    throw InputError("mesh.reference_file: has " + count(reference.num_elements(), "elements") + ", mesh.file " +
+                     count(mesh.num_elements(), "elements") + same);
+  for (std::size_t e = 0; e < mesh.num_elements(); ++e)
+    if (reference.elements[e] != mesh.elements[e]) {
+      const auto nodes = [](const std::array<int, 6>& el) {
+        std::string s;
+        for (int n : el) s += (s.empty() ? "" : " ") + std::to_string(n);
+        return s;
+      };
+      throw InputError("mesh.reference_file: element " + std::to_string(e) + " joins nodes " +
+                       nodes(reference.elements[e]) + ", in mesh.file " + nodes(mesh.elements[e]) + same);
+    }
+}
+
+// For a mesh read from a file, the likely reason it does not fit the box: another length unit.
+std::string unit_hint(const io::Config& config, std::size_t m) {
+  return config.get<std::string>(membrane_name(m) + ".mesh.family") == "file"
+             ? " (is the mesh file in another unit? mesh.scale converts it to metres, e.g. 1e-6 for micrometres)"
+             : "";
+}
+
 }  // namespace
 
 Simulation::Simulation(const io::Config& config)
@@ -133,17 +164,31 @@ void Simulation::build_membranes() {
       Mesh mesh;
       std::vector<Vec3> initial, reference;
       if (family == "file") {
-        // A user's mesh is the initial shape itself, placed by center and rotation; its reference is the same
-        // shape, or the reference sphere over the directions of its nodes (for star-shaped meshes).
+        // A user's mesh is the initial shape itself, its length unit times mesh.scale, placed by center and rotation;
+        // its reference is the same shape, the reference sphere over the directions of its nodes (for star-shaped
+        // meshes), or the shape of mesh.reference_file, scaled and placed alike.
         const std::string file = m.get<std::string>("mesh.file");
         require(!file.empty(), "mesh.file", "a Gmsh file name when mesh.family = \"file\"");
-        mesh = read_gmsh(file);
+        const double scale = m.get<double>("mesh.scale");
         const RigidTransform place = shape_of(m, false).placement;
-        for (const auto& p : mesh.nodes) initial.push_back(place.rotation * p + place.translation);
-        if (m.get<std::string>("reference") == "sphere") {
+        const auto placed = [&](const Mesh& read) {
+          std::vector<Vec3> X;
+          for (const auto& p : read.nodes) X.push_back(place.rotation * (scale * p) + place.translation);
+          return X;
+        };
+        mesh = read_gmsh(file);
+        initial = placed(mesh);
+        const std::string kind = m.get<std::string>("reference");
+        if (kind == "sphere") {
           std::vector<Vec3> unit;
           for (const auto& p : mesh.nodes) unit.push_back(normalized(p));
           reference = map_sphere(shape_of(m, true), unit);
+        } else if (kind == "file") {
+          const std::string reference_file = m.get<std::string>("mesh.reference_file");
+          require(!reference_file.empty(), "mesh.reference_file", "a Gmsh file name when reference = \"file\"");
+          const Mesh stress_free = read_gmsh(reference_file);
+          check_same_elements(stress_free, mesh);
+          reference = placed(stress_free);
         } else {
           reference = initial;
         }
@@ -179,13 +224,24 @@ void Simulation::check_geometry() const {
     try {
       check_nodes_in_domain(grid_, X);
     } catch (const SimulationError& e) {
-      throw InputError(membrane_name(m) + " lies outside the box: " + e.what());
+      throw InputError(membrane_name(m) + " lies outside the box: " + e.what() + unit_hint(config_, m));
+    }
+    for (int a = 0; a < 3; ++a) {
+      if (!grid_.periodic(a)) continue;  // between walls the nodes are checked against the walls
+      const auto [lo, hi] =
+          std::minmax_element(X.begin(), X.end(), [&](const Vec3& p, const Vec3& q) { return p[a] < q[a]; });
+      if ((*hi)[a] - (*lo)[a] >= grid_.length(a)) {
+        std::ostringstream s;
+        s << membrane_name(m) << " spans " << (*hi)[a] - (*lo)[a] << " m along " << kAxes[a]
+          << ": must be shorter than the periodic box (" << grid_.length(a) << " m)" << unit_hint(config_, m);
+        throw InputError(s.str());
+      }
     }
     const double d = min_wall_distance(grid_, X);
     if (d < h) {
       std::ostringstream s;
       s << membrane_name(m) << " comes within " << d << " m of a wall: must keep at least one cell (" << h
-        << " m) clear for the delta function";
+        << " m) clear for the delta function" << unit_hint(config_, m);
       throw InputError(s.str());
     }
   }
@@ -354,10 +410,14 @@ io::Checkpoint Simulation::checkpoint() const {
 }
 
 void Simulation::restore(const io::Checkpoint& ck) {
-  // The checkpoint's configuration must be this one, up to the keys a continued or branched run may change.
-  const io::Config theirs = config_.schema().parse_string(ck.get_string("config"), "checkpoint");
+  // The checkpoint's configuration must be this one, up to the keys a continued or branched run may change and
+  // the names of mesh files (a run folder's copy stands for its original; what the files hold is compared with
+  // the reference state below).
+  io::Config theirs = config_.schema().parse_string(ck.get_string("config"), "checkpoint");
+  leave_out_inapplicable(theirs);
   const auto may_change = [](const std::string& key) {
-    return key == "time.end" || key == "scenario.kt_end" || key.starts_with("output.") || key.starts_with("solver.");
+    return key == "time.end" || key == "scenario.kt_end" || key.starts_with("output.") || key.starts_with("solver.") ||
+           key == "mesh.file" || key == "mesh.reference_file";
   };
   const auto differ = [&](const std::string& key, const std::string& was, const std::string& is) {
     throw InputError(key + " = " + is + ": the checkpoint " + ck.source() + " was written with " + key + " = " + was +
@@ -371,6 +431,7 @@ void Simulation::restore(const io::Checkpoint& ck) {
       differ("[[" + t.name + "]] count", std::to_string(theirs.count(t.name)), std::to_string(config_.count(t.name)));
     for (std::size_t i = 0; i < config_.count(t.name); ++i)
       for (const auto& k : config_.entry(t.name, i).schema().keys()) {
+        if (may_change(k.key)) continue;
         const std::string was = theirs.entry(t.name, i).value_text(k.key), is = config_.entry(t.name, i).value_text(k.key);
         if (was != is) differ(t.name + "[" + std::to_string(i) + "]." + k.key, was, is);
       }
