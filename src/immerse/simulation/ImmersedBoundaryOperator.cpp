@@ -8,11 +8,13 @@
 #include <exception>
 #include <limits>
 #include <string>
+#include <utility>
 
 #include "immerse/core/Error.hpp"
 #include "immerse/core/Parallel.hpp"
 #include "immerse/fluid/MacGeom.hpp"
 #include "immerse/coupling/NodeDiagnostics.hpp"
+#include "immerse/timestep/LogEvent.hpp"
 
 namespace immerse {
 
@@ -24,6 +26,13 @@ void timed(double& seconds, F&& f) {
   const auto t0 = std::chrono::steady_clock::now();
   f();
   seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+/// Runs f as a phase of the step profile: its wall time is added to `seconds` and it is PETSc's log event `phase`.
+template <class F>
+void timed(double& seconds, Phase phase, F&& f) {
+  const LogEvent event(phase);
+  timed(seconds, std::forward<F>(f));
 }
 
 /// dst = src (resized), copied by the threads: the trial state's positions and velocities are saved at every
@@ -108,7 +117,7 @@ void ImmersedBoundaryOperator::membrane_force_density(std::span<const Vec3> X, F
   };
   // No enclosing region when the membranes go one at a time: a region nested in an inactive one gets freshly
   // created threads in libgomp at every call (tens of microseconds each, once per pass of every force).
-  timed(timings_.force, [&] {
+  timed(timings_.force, Phase::MembraneForces, [&] {
     if (across) {
 #pragma omp parallel
       {
@@ -122,7 +131,7 @@ void ImmersedBoundaryOperator::membrane_force_density(std::span<const Vec3> X, F
   });
   for (const auto& e : error)
     if (e) std::rethrow_exception(e);
-  timed(timings_.spread, [&] { coupler_.spread_force(X, F_, f); });
+  timed(timings_.spread, Phase::Spreading, [&] { coupler_.spread_force(X, F_, f); });
 }
 
 template <class F>
@@ -142,7 +151,7 @@ double ImmersedBoundaryOperator::trial_step(std::span<const double> Xf, double t
     start_valid_ = true;
   }
   membrane_force_density(nodes(Xf), force_);
-  timed(timings_.fluid, [&] {
+  timed(timings_.fluid, Phase::FluidStep, [&] {
     if (theta < 1.0) blend(fluid_.grid(), theta, force_, force_start_, mixed_);
     if (!prepared_.prepared_for(committed_, dt)) timed(occasional, [&] { fluid_.prepare(committed_, dt, prepared_); });
     fluid_.step(prepared_, theta < 1.0 ? mixed_ : force_, trial_);
@@ -155,7 +164,7 @@ void ImmersedBoundaryOperator::trial_velocity(std::span<const double> Xf, double
                                               double dt, std::span<double> U) {
   governed([&] {
     const double occasional = trial_step(Xf, theta, dt);
-    timed(timings_.interpolate, [&] {
+    timed(timings_.interpolate, Phase::Interpolation, [&] {
       coupler_.interpolate_velocity(trial_.u, nodes(Xi), {reinterpret_cast<Vec3*>(U.data()), U.size() / 3});
     });
     return occasional;
@@ -169,7 +178,7 @@ void ImmersedBoundaryOperator::trial_mean_velocity(std::span<const double> Xf, s
                                                    std::span<double> U) {
   governed([&] {
     const double occasional = trial_step(Xf, 1.0, dt);
-    timed(timings_.interpolate, [&] {
+    timed(timings_.interpolate, Phase::Interpolation, [&] {
       blend(fluid_.grid(), 0.5, trial_.u, committed_.u, mean_);
       coupler_.interpolate_velocity(mean_, nodes(Xi), {reinterpret_cast<Vec3*>(U.data()), U.size() / 3});
     });
@@ -179,7 +188,7 @@ void ImmersedBoundaryOperator::trial_mean_velocity(std::span<const double> Xf, s
 }
 
 void ImmersedBoundaryOperator::committed_velocity(std::span<const double> Xi, std::span<double> U) {
-  timed(timings_.interpolate, [&] {
+  timed(timings_.interpolate, Phase::Interpolation, [&] {
     coupler_.interpolate_velocity(committed_.u, nodes(Xi), {reinterpret_cast<Vec3*>(U.data()), U.size() / 3});
   });
 }
@@ -192,7 +201,7 @@ void ImmersedBoundaryOperator::commit(std::span<const double> X, double) {
   if (trial_U_valid_ && trial_matches(X))
     std::swap(U_, trial_U_);
   else
-    timed(timings_.interpolate, [&] { coupler_.interpolate_velocity(committed_.u, X_, U_); });
+    timed(timings_.interpolate, Phase::Interpolation, [&] { coupler_.interpolate_velocity(committed_.u, X_, U_); });
   trial_U_valid_ = false;
   // An implicit step's last trial was driven by X^{n+1} itself: its S(X^{n+1}) f(X^{n+1}) is the next step's start.
   // Otherwise the start force is computed when a trial first needs it (never by the explicit schemes, theta = 1).

@@ -140,7 +140,11 @@ ConfigSchema run_schema() {
   s.add_string("solver.initial_guess", "recurrence", {"recurrence", "extrapolation"},
                "Newton's start: the linear extrapolation of §3 step 1 plus the error a recurrence fitted to the last "
                "steps' errors predicts (recurrence), or the extrapolation alone (extrapolation, the paper's)");
-  s.add_string("solver.petsc_options", "", {}, "extra PETSc options, e.g. \"-ksp_gmres_restart 50\"");
+  s.add_string("solver.petsc_options", "", {},
+               "PETSc options of the implicit schemes' solver (jfnk: SNES, KSP, PC, MatMFFD; anderson, lbfgs: SNES) "
+               "and of PETSc itself (-log_view, -options_left), e.g. \"-ksp_gmres_restart 50 -snes_converged_reason\"; "
+               "they win over the environment variable PETSC_OPTIONS, both over the solver.* settings; an option no "
+               "object used stops the run after its first solve (exit 2; user guide, PETSc options)");
 
   s.add_int("output.diagnostics_every", 1, Range::at_least(1), "steps between rows of diagnostics.csv");
   s.add_int("output.fields_every", 0, Range::at_least(0), "steps between ParaView frames (XDMF + HDF5); 0: none");

@@ -442,6 +442,12 @@ int run_command(const RunOptions& options, std::ostream& out, std::ostream& err)
     status = 4;  // while a rejected step was to be retried: the state is the last accepted step's
   } catch (const WriteError& e) {
     write_failed(e);
+  } catch (const InputError&) {
+    // Bad input that shows only once the run is on (a PETSc option no solver object used in the first solve): exit 2
+    // as if found before writing, so this run's files go again; a restart in its checkpoint's folder keeps it.
+    progress.finish();
+    if (!in_place) folder.remove_run_files();
+    throw;
   }
   progress.finish();
   // The last state is always saved, whatever ended the run (after an instability: the unstable state, for

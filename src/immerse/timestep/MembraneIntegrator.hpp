@@ -35,8 +35,8 @@ class MembraneIntegrator {
   /// (stats.converged == false, stats.failure says why).
   virtual StepStats step(CoupledOperator& op, double dt) = 0;
   virtual std::string name() const = 0;
-  /// Sets the scheme up for `unknowns` unknowns before the first step, so that a run reports bad solver options
-  /// (InputError) before it writes anything. Optional: step() sets up what it needs.
+  /// Sets the scheme up for `unknowns` unknowns before the first step, so that a run reports solver options PETSc
+  /// rejects (InputError) before it writes anything. Optional: step() sets up what it needs.
   virtual void prepare(std::size_t /*unknowns*/) {}
 
   /// Positions X^{n-1} and step dt^{n-1} before the committed ones, used by the implicit schemes' initial guess

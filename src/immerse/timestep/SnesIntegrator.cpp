@@ -2,10 +2,12 @@
 #include "immerse/core/Parallel.hpp"
 
 #include <cmath>
+#include <cstdlib>
 #include <sstream>
 #include <stdexcept>
 
 #include "immerse/core/Error.hpp"
+#include "immerse/timestep/LogEvent.hpp"
 #include "immerse/timestep/PetscSession.hpp"
 
 namespace immerse {
@@ -23,14 +25,91 @@ constexpr double kStallFactor = 0.5;
 
 SnesIntegrator::SnesIntegrator(Method method, const SolverSettings& settings) : method_(method), settings_(settings) {
   settings_.validate();
+  if (const char* env = std::getenv("PETSC_OPTIONS")) environment_options_ = env;
   IMMERSE_PETSC(PetscOptionsCreate(&options_));
-  if (!settings_.petsc_options.empty() && PetscOptionsInsertString(options_, settings_.petsc_options.c_str()) != 0)
-    throw InputError("solver.petsc_options = '" + settings_.petsc_options + "': PETSc cannot parse it");
+  // PETSC_OPTIONS first, so that solver.petsc_options wins where both give an option.
+  insert_options(options_, "PETSC_OPTIONS", environment_options_);
+  insert_options(options_, "solver.petsc_options", settings_.petsc_options);
+  // PETSc's global database, which PetscInitialize filled from PETSC_OPTIONS, takes solver.petsc_options too: it
+  // holds the options PETSc reads at PetscFinalize, and the table -log_view prints.
+  insert_options(nullptr, "solver.petsc_options", settings_.petsc_options);
+  // Options PETSc reads from its global database count as used here; PetscInitialize started logging only if
+  // PETSC_OPTIONS asked for it.
+  PetscBool log_view = PETSC_FALSE, given = PETSC_FALSE, logging = PETSC_FALSE;
+  IMMERSE_PETSC(PetscOptionsHasName(options_, nullptr, "-log_view", &log_view));
+  IMMERSE_PETSC(PetscOptionsHasName(options_, nullptr, "-options_left", &given));
+  IMMERSE_PETSC(PetscOptionsHasName(options_, nullptr, "-options_view", &given));
+  IMMERSE_PETSC(PetscLogIsActive(&logging));
+  if (log_view && !logging) IMMERSE_PETSC(PetscLogDefaultBegin());
 }
 
 SnesIntegrator::~SnesIntegrator() {
   destroy();
-  if (options_) PetscOptionsDestroy(&options_);
+  if (!options_) return;
+  // The options this solver used count as used in the global database too, which -options_left reports on.
+  PetscInt left = 0;
+  char **names = nullptr, **values = nullptr;
+  if (PetscOptionsLeftGet(nullptr, &left, &names, &values) == 0) {
+    for (PetscInt i = 0; i < left; ++i) {
+      PetscBool used = PETSC_FALSE, given = PETSC_FALSE;
+      std::string option(1, '-');
+      option += names[i];
+      if (PetscOptionsUsed(options_, names[i], &used) == 0 && used)
+        PetscOptionsHasName(nullptr, nullptr, option.c_str(), &given);
+    }
+    PetscOptionsLeftRestore(nullptr, &left, &names, &values);
+  }
+  PetscOptionsDestroy(&options_);
+}
+
+void SnesIntegrator::insert_options(PetscOptions options, const char* source, const std::string& text) {
+  if (!text.empty() && PetscOptionsInsertString(options, text.c_str()) != 0)
+    throw InputError(std::string(source) + " = '" + text + "': PETSc cannot parse it");
+}
+
+std::string SnesIntegrator::options_given() const {
+  std::string s = environment_options_.empty() ? "" : "PETSC_OPTIONS = '" + environment_options_ + "'";
+  if (s.empty() || !settings_.petsc_options.empty())
+    s += (s.empty() ? "" : ", ") + std::string("solver.petsc_options = '") + settings_.petsc_options + "'";
+  return s;
+}
+
+void SnesIntegrator::check_options_used() {
+  options_checked_ = true;
+  PetscInt left = 0;
+  char **names = nullptr, **values = nullptr;
+  IMMERSE_PETSC(PetscOptionsLeftGet(options_, &left, &names, &values));
+  const std::vector<std::string> unused(names, names + left);
+  IMMERSE_PETSC(PetscOptionsLeftRestore(options_, &left, &names, &values));
+  PetscOptions config = nullptr;  // solver.petsc_options alone: where an unused option came from
+  IMMERSE_PETSC(PetscOptionsCreate(&config));
+  PetscOptionsInsertString(config, settings_.petsc_options.c_str());  // parsed once already (constructor)
+  std::string from_config, from_environment;
+  int count = 0;
+  for (const std::string& n : unused) {
+    std::string option(1, '-');
+    option += n;
+    PetscBool in_config = PETSC_FALSE, read_at_start = PETSC_FALSE;  // by PetscInitialize, e.g. -malloc_debug
+    PetscOptionsHasName(config, nullptr, option.c_str(), &in_config);
+    PetscOptionsUsed(nullptr, n.c_str(), &read_at_start);
+    if (!in_config && read_at_start) continue;
+    std::string& list = in_config ? from_config : from_environment;
+    list += (list.empty() ? "" : ", ") + option;
+    ++count;
+  }
+  PetscOptionsDestroy(&config);
+  if (count == 0) return;
+  auto part = [](const char* source, const std::string& list) {
+    if (list.empty()) return std::string();
+    return std::string(source) + (list.find(',') == std::string::npos ? ": option " : ": options ") + list;
+  };
+  std::string parts = part("solver.petsc_options", from_config);
+  if (!from_environment.empty()) parts += (parts.empty() ? "" : "; ") + part("PETSC_OPTIONS", from_environment);
+  throw InputError(parts + (count == 1 ? " was" : " were") + " used by none of the '" + name() +
+                   "' solver's PETSc objects (" +
+                   (method_ == Method::NewtonKrylov ? "SNES, KSP, PC, MatMFFD" : "SNES only: no KSP, PC or MatMFFD") +
+                   ") in its first solve, nor by PETSc itself: misspelt, or an option of another object (see "
+                   "PETSc's -help)");
 }
 
 void SnesIntegrator::destroy() {
@@ -74,6 +153,7 @@ void SnesIntegrator::setup(std::size_t n) {
     IMMERSE_PETSC(PCSetType(pc, PCNONE));  // the paper's GMRES is unpreconditioned
     IMMERSE_PETSC(KSPConvergedDefaultCreate(&ksp_default_ctx_));
     IMMERSE_PETSC(KSPSetConvergenceTest(ksp, &SnesIntegrator::gmres_converged, this, nullptr));
+    IMMERSE_PETSC(PetscOptionsHasName(options_, nullptr, "-ksp_atol", &user_atol_));
   } else if (method_ == Method::Anderson) {
     IMMERSE_PETSC(SNESSetType(snes_, SNESANDERSON));
     set_option("-snes_anderson_m", settings_.anderson_memory);
@@ -88,30 +168,16 @@ void SnesIntegrator::setup(std::size_t n) {
   IMMERSE_PETSC(SNESGetLineSearch(snes_, &ls));
   IMMERSE_PETSC(SNESLineSearchSetType(ls, SNESLINESEARCHBASIC));  // full steps: eq. (34) (Anderson takes none)
   IMMERSE_PETSC(SNESSetSolution(snes_, x_));
-  IMMERSE_PETSC(PetscOptionsHasName(options_, nullptr, "-ksp_atol", &user_atol_));
   try {
     IMMERSE_PETSC(SNESSetFromOptions(snes_));
     IMMERSE_PETSC(SNESSetUp(snes_));
   } catch (const std::runtime_error& e) {
-    throw InputError("solver.petsc_options = '" + settings_.petsc_options + "': " + e.what());
+    throw InputError(options_given() + ": " + e.what());
   }
-  PetscInt left = 0;
-  char **names = nullptr, **values = nullptr;
-  IMMERSE_PETSC(PetscOptionsLeftGet(options_, &left, &names, &values));
-  std::string unused;
-  for (PetscInt i = 0; i < left; ++i) unused += (unused.empty() ? "-" : ", -") + std::string(names[i]);
-  IMMERSE_PETSC(PetscOptionsLeftRestore(options_, &left, &names, &values));
-  if (unused.empty()) return;
-  if (method_ == Method::NewtonKrylov)
-    throw InputError("solver.petsc_options: PETSc does not know option " + unused + " for the '" + name() +
-                     "' solver (see -help of PETSc's SNES, KSP and MatMFFD)");
-  throw InputError("solver.petsc_options: the '" + name() + "' solver does not use option " + unused +
-                   " (PETSc does not know it, or it belongs to JFNK's KSP or matrix-free Jacobian; see -help of "
-                   "PETSc's SNES)");
 }
 
 void SnesIntegrator::set_option(const char* name, double value) {
-  PetscBool given = PETSC_FALSE;  // solver.petsc_options wins over the setting
+  PetscBool given = PETSC_FALSE;  // solver.petsc_options and PETSC_OPTIONS win over the setting
   IMMERSE_PETSC(PetscOptionsHasName(options_, nullptr, name, &given));
   if (given) return;
   std::ostringstream v;
@@ -130,6 +196,7 @@ std::string SnesIntegrator::name() const {
 }
 
 PetscErrorCode SnesIntegrator::form_function(SNES, Vec x, Vec f, void* ctx) {
+  const LogEvent event(Phase::ImplicitResidual);
   auto* self = static_cast<SnesIntegrator*>(ctx);
   const PetscScalar* xs;
   PetscScalar* fs;
@@ -234,6 +301,8 @@ StepStats SnesIntegrator::step(CoupledOperator& op, double dt) {
   stats.newton_its = static_cast<int>(its);
   stats.gmres_its = static_cast<int>(lits);
   stats.residual = last_ratio_;
+  // Some options are read only while solving (-snes_converged_reason, -ksp_view): checked once a solve has iterated.
+  if (!options_checked_ && ierr == 0 && (its > 0 || lits > 0)) check_options_used();
   SNESConvergedReason reason = SNES_CONVERGED_ITERATING;
   if (ierr == 0) SNESGetConvergedReason(snes_, &reason);
   if (ierr != 0 || reason <= 0) {

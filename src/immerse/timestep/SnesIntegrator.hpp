@@ -31,7 +31,10 @@
 //
 // Positions are measured in the operator's length scale inside the solver, so that eq. (37)'s perturbation is
 // relative to the geometry whatever the physical units (docs/theory/conventions.md, "The implicit step").
-// Every PETSc option stays overridable through SolverSettings::petsc_options.
+// Every PETSc option stays overridable through SolverSettings::petsc_options and the environment variable
+// PETSC_OPTIONS (the former wins; both win over the settings); an option that no PETSc object of the solver, nor
+// PETSc itself, has used by the end of the first solve that iterates is an InputError (docs/user-guide.md, "PETSc
+// options").
 #include <petscsnes.h>
 
 #include <exception>
@@ -52,7 +55,8 @@ class SnesIntegrator final : public MembraneIntegrator {
 
   StepStats step(CoupledOperator& op, double dt) override;
   std::string name() const override;
-  /// Creates the PETSc solver with solver.petsc_options applied; an option PETSc rejects is an InputError.
+  /// Creates the PETSc solver with PETSC_OPTIONS and solver.petsc_options applied; a value PETSc rejects is an
+  /// InputError.
   void prepare(std::size_t unknowns) override;
 
  private:
@@ -60,6 +64,11 @@ class SnesIntegrator final : public MembraneIntegrator {
   // Sets a PETSc option of this solver (its private options database) from a setting, unless solver.petsc_options
   // gives it.
   void set_option(const char* name, double value);
+  static void insert_options(PetscOptions options, const char* source, const std::string& text);
+  // "PETSC_OPTIONS = '...', solver.petsc_options = '...'" as far as given, for error messages.
+  std::string options_given() const;
+  // InputError naming each option of the solver's database that nothing used.
+  void check_options_used();
   void destroy();
   static PetscErrorCode form_function(SNES, Vec x, Vec f, void* ctx);
   static PetscErrorCode converged(SNES, PetscInt it, PetscReal xnorm, PetscReal snorm, PetscReal fnorm,
@@ -69,7 +78,9 @@ class SnesIntegrator final : public MembraneIntegrator {
 
   Method method_;
   SolverSettings settings_;
-  PetscOptions options_ = nullptr;
+  std::string environment_options_;  // PETSC_OPTIONS
+  PetscOptions options_ = nullptr;     // PETSC_OPTIONS, then solver.petsc_options, then the settings' options
+  bool options_checked_ = false;
   SNES snes_ = nullptr;
   Mat J_ = nullptr;
   Vec x_ = nullptr, r_ = nullptr;
@@ -81,7 +92,7 @@ class SnesIntegrator final : public MembraneIntegrator {
   std::vector<double> X_, g_;
   std::exception_ptr callback_error_;
   double last_ratio_ = 0;
-  // -ksp_atol given in petsc_options: it replaces the stop at 0.9 of the Newton tolerance.
+  // -ksp_atol given (solver.petsc_options or PETSC_OPTIONS): it replaces the stop at 0.9 of the Newton tolerance.
   PetscBool user_atol_ = PETSC_FALSE;
   void* ksp_default_ctx_ = nullptr;  // PETSc's default KSP test, which gmres_converged extends
   std::vector<double> gmres_history_;  // the current solve's residual norms
