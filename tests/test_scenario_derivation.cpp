@@ -276,3 +276,28 @@ TEST(CustomKind, GivenAndDerivedDoNotChangeEquality) {
   const io::Config b = run_schema().parse_string(a.to_toml_string(), "resolved");
   EXPECT_TRUE(a == b);
 }
+
+// "custom" is the default kind; "none", its former name, resolves to the same configuration (apart from the name).
+TEST(CustomKind, NoneIsTheFormerNameOfCustom) {
+  const char* text = R"(
+[domain]
+Lx = 4.0
+Ly = 4.0
+Lz = 4.0
+[boundary]
+z = "wall"
+z_lower_velocity = [-1.0, 0.0, 0.0]
+z_upper_velocity = [1.0, 0.0, 0.0]
+[[membrane]]
+radius = 0.5
+)";
+  const io::Config by_default = resolve(text);
+  EXPECT_EQ(by_default.get<std::string>("scenario.kind"), "custom");
+  const io::Config none = resolve(text, {"scenario.kind=\"none\""});
+  EXPECT_TRUE(resolve(text, {"scenario.kind=\"custom\""}) == by_default);
+  EXPECT_TRUE(resolve(text, {"scenario.kind=\"none\"", "scenario.kind=\"custom\""}) == by_default);
+  EXPECT_EQ(none.value_text("membrane[0].center"), by_default.value_text("membrane[0].center"));
+  // Walls z = const moving along x define the shear rate k = (u_upper - u_lower) / Lz of the kt column.
+  EXPECT_DOUBLE_EQ(shear_rate(none), 0.5);
+  EXPECT_DOUBLE_EQ(shear_rate(by_default), 0.5);
+}

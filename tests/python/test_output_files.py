@@ -16,7 +16,7 @@ PROGRAM = os.environ["IMMERSE_PROGRAM"]
 # Two spheres of radius 1 side by side in a periodic box (nondimensional units), one stretched along x.
 CONFIG = """
 [scenario]
-kind = "none"
+kind = "custom"
 [domain]
 Lx = 8.0
 Ly = 4.0

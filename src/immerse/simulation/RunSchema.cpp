@@ -61,10 +61,12 @@ ConfigSchema membrane_schema() {
 
 ConfigSchema run_schema() {
   ConfigSchema s;
-  s.add_string("scenario.kind", "none",
-               {"none", "oscillating_membrane", "capsule_shear", "oblate_shear", "bending_shear", "rbc_stretch",
-                "rbc_channel"},
-               "experiment whose nondimensional groups below set the dimensional values (see scenarios/README.md)");
+  s.add_string("scenario.kind", "custom",
+               {"custom", "none", "oscillating_membrane", "capsule_shear", "oblate_shear", "bending_shear",
+                "rbc_stretch", "rbc_channel"},
+               "custom: your own experiment, every value as given (\"none\" is its former name); otherwise an experiment "
+               "of the paper whose nondimensional groups below set the dimensional values the file leaves unset "
+               "(see scenarios/README.md)");
   s.add_double("scenario.G", 0.05, Range::positive(), "capillary number G = mu k a / E_s of eq. (44) (shear scenarios)");
   s.add_double("scenario.Re", 1e-3, Range::positive(), "Reynolds number Re = rho k a^2 / mu (shear scenarios)");
   s.add_double("scenario.kappa_B_hat", 0.0, Range::non_negative(), "reduced bending modulus kappa_B / (a^2 E_s) (§4.2.3)");

@@ -31,9 +31,15 @@ bool is_shear(const std::string& kind) {
 }  // namespace
 
 double shear_rate(const io::Config& c) {
-  if (!is_shear(c.get<std::string>("scenario.kind"))) return 0.0;
-  const double a = c.get<double>("membrane[0].radius");
-  return c.get<double>("scenario.Re") * c.get<double>("fluid.mu") / (c.get<double>("fluid.rho") * a * a);
+  if (is_shear(c.get<std::string>("scenario.kind"))) {
+    const double a = c.get<double>("membrane[0].radius");
+    return c.get<double>("scenario.Re") * c.get<double>("fluid.mu") / (c.get<double>("fluid.rho") * a * a);
+  }
+  // Any other kind: walls z = const moving along x only, as in a plane Couette flow.
+  if (c.get<std::string>("boundary.z") != "wall") return 0.0;
+  const Vec3 lo = c.get<Vec3>("boundary.z_lower_velocity"), hi = c.get<Vec3>("boundary.z_upper_velocity");
+  if (lo.y != 0 || lo.z != 0 || hi.y != 0 || hi.z != 0) return 0.0;
+  return std::abs(hi.x - lo.x) / c.get<double>("domain.Lz");
 }
 
 std::vector<Vec3> channel_cell_centres(const io::Config& c) {
@@ -151,7 +157,7 @@ io::Config derive_shear(const io::Config& config, const std::string& kind) {
   const double a = config.get<double>("membrane[0].radius"), mu = config.get<double>("fluid.mu");
   const double k = shear_rate(config), Lz = config.get<double>("domain.Lz");
   const std::string rate = "scenario.Re, fluid.mu, fluid.rho, membrane[0].radius";
-  const std::string own = "; for other walls use scenario.kind = \"none\"";
+  const std::string own = "; for other walls use scenario.kind = \"custom\"";
   d.fill("membrane[0].law", "\"neo_hookean\"", "the neo-Hookean capsule of §4.2");
   d.pair("membrane[0].Es", "scenario.G", rate, [&](double G) { return mu * k * a / G; },
          [&](double Es) { return mu * k * a / Es; });
@@ -193,7 +199,7 @@ io::Config derive_cells(const io::Config& config, const std::string& kind) {
             std::string("\"") + bc + "\" for scenario.kind = \"rbc_channel\" (flow along the periodic y axis)");
   const auto centres = channel_cell_centres(config);
   const std::string arrangement = "the channel's arrangement of 32 cells in the domain";
-  d.fix("membrane[0].center", vec(centres[0]), arrangement, "; for other positions use scenario.kind = \"none\"");
+  d.fix("membrane[0].center", vec(centres[0]), arrangement, "; for other positions use scenario.kind = \"custom\"");
   io::Config derived = d.take();
   const io::Config cell = derived.entry("membrane", 0);
   const std::string how = "scenario.kind = \"rbc_channel\" from membrane[0] and " + arrangement;

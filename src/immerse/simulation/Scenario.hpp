@@ -35,7 +35,8 @@ void leave_out_inapplicable(io::Config& config);
 /// rbc_channel: the centres of the 32 cells (see above).
 std::vector<Vec3> channel_cell_centres(const io::Config& config);
 
-/// The shear rate k of a shear scenario (0 for other kinds).
+/// The shear rate k of a shear scenario or of a plane Couette flow between walls z = const moving along x (0 when
+/// there is none).
 double shear_rate(const io::Config& config);
 
 }  // namespace immerse
