@@ -154,6 +154,13 @@ ConfigSchema run_schema() {
   s.add_int("output.checkpoint_every", 0, Range::at_least(0), "steps between checkpoints; 0: only at the end");
   s.add_double("output.log_seconds", 10.0, Range::positive(), "wall-clock seconds between log lines when not on a terminal");
 
+  s.add_double("packing.volume_fraction", 0.0, Range::closed(0, 0.7),
+               "fill the box to this volume fraction with copies of membrane[0] at random positions and orientations "
+               "(src/immerse/simulation/CellPacking.hpp); 0: the [[membrane]] entries as given");
+  s.add_int("packing.count", 0, Range::at_least(0), "place this many copies of membrane[0] instead (0: none)");
+  s.add_int("packing.seed", 1, Range::at_least(0), "seed of the random positions and orientations");
+  s.add_double("packing.clearance", 0.0, Range::non_negative(),
+               "least distance between nodes of two copies and from a node to a wall (m); 0: 1.1 grid spacings");
   s.add_table_array("membrane", membrane_schema(), 0, "the membranes (capsules, cells), one [[membrane]] table each");
   return s;
 }

@@ -332,6 +332,7 @@ int run_command(const RunOptions& options, std::ostream& out, std::ostream& err)
     out << "# immerse " << provenance.version << " (commit " << provenance.commit << "): " << options.file.string()
         << " -> " << dir.string() << "\n";
     for (const auto& line : derived_values(copies.config)) out << "# derived: " << line << "\n";
+    if (!sim.packing_summary().empty()) out << "# " << sim.packing_summary() << "\n";
     if (options.verbose)
       out << "# resolved configuration (saved as config.resolved.toml)\n" << copies.config.to_toml_string();
     out << std::flush;

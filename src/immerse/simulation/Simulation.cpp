@@ -8,6 +8,8 @@
 #include "immerse/core/Error.hpp"
 #include "immerse/fluid/PoiseuilleFlow.hpp"
 #include "immerse/coupling/NodeDiagnostics.hpp"
+#include "immerse/io/TomlFormat.hpp"
+#include "immerse/membrane/Geometry.hpp"
 #include "immerse/membrane/GmshReader.hpp"
 #include "immerse/membrane/MeshGenerator.hpp"
 #include "immerse/membrane/MeshValidation.hpp"
@@ -15,6 +17,7 @@
 #include "immerse/membrane/Shape.hpp"
 #include "immerse/membrane/Skalak.hpp"
 #include "immerse/membrane/Yeoh.hpp"
+#include "immerse/simulation/CellPacking.hpp"
 #include "immerse/simulation/MembraneClearance.hpp"
 #include "immerse/simulation/Scenario.hpp"
 #include "immerse/timestep/DenseBfgs.hpp"
@@ -141,6 +144,7 @@ Simulation::Simulation(const io::Config& config)
       coupler_(grid_, delta_kernel(config.get<std::string>("coupling.kernel"))),
       stepper_(config.get<double>("time.dt"), config.get<double>("time.dt_min")) {
   build_membranes();
+  pack_membranes();
   check_geometry();
   std::vector<const ElasticMembrane*> ms;
   for (auto& m : membranes_) ms.push_back(m.get());
@@ -199,21 +203,88 @@ void Simulation::build_membranes() {
       }
       mesh.nodes = initial;
       validate_closed_mesh(mesh, name);
-      Bending bending{m.get<double>("kappa_B"), m.get<std::string>("bending_reference") == "rest"
-                                                     ? ReferenceCurvature::RestShape
-                                                     : ReferenceCurvature::Zero};
-      membranes_.push_back(std::make_unique<ElasticMembrane>(
-          mesh, reference, law_of(m), bending,
-          m.get<std::string>("force") == "energy" ? ForceMethod::Energy : ForceMethod::Contour));
-      meshes_.push_back(std::move(mesh));
-      references_.push_back(std::move(reference));
-      initial_.push_back(std::move(initial));
+      add_membrane(m, std::move(mesh), std::move(initial), std::move(reference));
     } catch (const InputError& e) {
       // A key of the entry becomes membrane[i].key; the membrane's own "membrane reference element 3" becomes
       // "membrane[i] reference element 3".
       const std::string what = e.what();
       throw InputError(what.rfind("membrane ", 0) == 0 ? name + what.substr(8) : name + "." + what);
     }
+  }
+}
+
+void Simulation::add_membrane(const io::Config& m, Mesh mesh, std::vector<Vec3> initial, std::vector<Vec3> reference) {
+  Bending bending{m.get<double>("kappa_B"), m.get<std::string>("bending_reference") == "rest"
+                                                 ? ReferenceCurvature::RestShape
+                                                 : ReferenceCurvature::Zero};
+  membranes_.push_back(std::make_unique<ElasticMembrane>(
+      mesh, reference, law_of(m), bending,
+      m.get<std::string>("force") == "energy" ? ForceMethod::Energy : ForceMethod::Contour));
+  meshes_.push_back(std::move(mesh));
+  references_.push_back(std::move(reference));
+  initial_.push_back(std::move(initial));
+}
+
+// [packing]: membrane[0] is the template; its copies replace it, placed by CellPacking.
+void Simulation::pack_membranes() {
+  const double fraction = config_.get<double>("packing.volume_fraction");
+  const auto count = config_.get<std::int64_t>("packing.count");
+  if (fraction == 0 && count == 0) return;
+  if (fraction > 0 && count > 0)
+    throw InputError("packing.count = " + std::to_string(count) + " and packing.volume_fraction = " +
+                     config_.value_text("packing.volume_fraction") + ": give only one of them");
+  const char* key = count > 0 ? "packing.count" : "packing.volume_fraction";
+  if (config_.count("membrane") != 1)
+    throw InputError(std::string(key) + ": packs copies of one [[membrane]] entry, the template; " +
+                     std::to_string(config_.count("membrane")) + " are given");
+  // The template's placement must be the default one (as config.resolved.toml records it): the packer's replaces it.
+  const io::Config& t = config_.entry("membrane", 0);
+  Vec3 box_centre;
+  for (int a = 0; a < 3; ++a) box_centre[a] = grid_.origin()[a] + 0.5 * grid_.length(a);
+  const Vec3 centre = t.get<Vec3>("center");
+  for (const auto& [k, placed] : {std::pair{"center", norm(centre - box_centre) > 1e-9 * grid_.h()},
+                                  std::pair{"rotation_angle", t.get<double>("rotation_angle") != 0}})
+    if (placed)
+      throw InputError(std::string("membrane[0].") + k + " = " + t.value_text(k) + ": does not apply with " + key +
+                       " (the packer places and turns the copies)");
+  const Mesh tmpl = meshes_[0];
+  const MembraneGeometry g = measure(tmpl, initial_[0]);
+  std::vector<Vec3> shape, reference;
+  for (const auto& p : initial_[0]) shape.push_back(p - g.centroid);
+  for (const auto& p : references_[0]) reference.push_back(p - g.centroid);
+  double spacing = 0;  // along the element edges, vertex to mid-side node
+  for (const auto& e : tmpl.elements)
+    for (const auto& [a, b] : {std::pair{0, 3}, {3, 1}, {1, 4}, {4, 2}, {2, 5}, {5, 0}})
+      spacing = std::max(spacing, norm(shape[e[a]] - shape[e[b]]));
+  double box = 1;
+  for (int a = 0; a < 3; ++a) box *= grid_.length(a);
+  PackingRequest request;
+  request.count = count > 0 ? static_cast<std::size_t>(count) : static_cast<std::size_t>(std::llround(fraction * box / g.volume));
+  if (request.count == 0)
+    throw InputError("packing.volume_fraction = " + config_.value_text("packing.volume_fraction") +
+                     ": less than one cell of volume " + io::format_number(g.volume) + " m^3 in this box");
+  request.seed = static_cast<std::uint64_t>(config_.get<std::int64_t>("packing.seed"));
+  const double clearance = config_.get<double>("packing.clearance");
+  request.clearance = clearance > 0 ? clearance : 1.1 * grid_.h();
+  const auto t0 = std::chrono::steady_clock::now();
+  const CellPacking packing(grid_, shape, spacing, request, key);
+  std::ostringstream summary;
+  summary << "packing: " << request.count << " copies of membrane[0], volume fraction "
+          << static_cast<double>(request.count) * g.volume / box << " (seed " << request.seed << "), in "
+          << std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count() << " s";
+  packing_summary_ = summary.str();
+  const io::Config& m = config_.entry("membrane", 0);
+  meshes_.clear();
+  references_.clear();
+  initial_.clear();
+  membranes_.clear();
+  for (const auto& place : packing.placements()) {
+    Mesh mesh = tmpl;
+    std::vector<Vec3> X, R;
+    for (const auto& p : shape) X.push_back(place.rotation * p + place.translation);
+    for (const auto& p : reference) R.push_back(place.rotation * p + place.translation);
+    mesh.nodes = X;
+    add_membrane(m, std::move(mesh), std::move(X), std::move(R));
   }
 }
 

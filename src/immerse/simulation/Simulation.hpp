@@ -44,6 +44,8 @@ class Simulation {
   long step() const { return step_; }
   double time() const { return op_->fluid_state().time; }
   const io::Config& config() const { return config_; }
+  /// "packing: N copies of membrane[0], volume fraction ..., in T s" when [packing] placed the membranes, else empty.
+  const std::string& packing_summary() const { return packing_summary_; }
   const Grid& grid() const { return grid_; }
   const ImmersedBoundaryOperator& op() const { return *op_; }
   std::size_t num_membranes() const { return meshes_.size(); }
@@ -62,6 +64,8 @@ class Simulation {
 
  private:
   void build_membranes();
+  void add_membrane(const io::Config& m, Mesh mesh, std::vector<Vec3> initial, std::vector<Vec3> reference);
+  void pack_membranes();
   FluidState initial_fluid_state() const;
   void check_geometry() const;
   void check_stability(const StepRecord& r) const;
@@ -78,6 +82,7 @@ class Simulation {
   std::unique_ptr<MembraneIntegrator> integrator_;
   AdaptiveStepper stepper_;
   long step_ = 0;
+  std::string packing_summary_;
 };
 
 }  // namespace immerse
