@@ -47,6 +47,15 @@ std::filesystem::path bundled_scenarios() {
   return std::filesystem::path(IMMERSE_SOURCE_DIR) / "scenarios";
 }
 
+/// A standard output that was closed (`| head`) is not an error of the command: what is left goes nowhere.
+void silence_closed_stdout() {
+  if (!std::cout || std::fflush(stdout) != 0) {
+    std::cout.clear();
+    std::clearerr(stdout);
+    if (const int null = open("/dev/null", O_WRONLY); null >= 0) dup2(null, STDOUT_FILENO);
+  }
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -106,15 +115,15 @@ int main(int argc, char** argv) {
       const int status = immerse::run_command(run_opts, std::cout, std::cerr);
       // The outcome is decided and reported: a late stop request must not turn it into death by signal.
       for (int sig : {SIGINT, SIGTERM, SIGHUP, SIGQUIT, SIGPIPE}) std::signal(sig, SIG_IGN);
-      // A standard output that was closed (`| head`) is not an error of the run: what is left goes nowhere.
-      if (!std::cout || std::fflush(stdout) != 0) {
-        std::cout.clear();
-        std::clearerr(stdout);
-        if (const int null = open("/dev/null", O_WRONLY); null >= 0) dup2(null, STDOUT_FILENO);
-      }
+      silence_closed_stdout();
       return status;
     }
-    if (*verify) return run_verify(study, quick);
+    if (*verify) {
+      std::signal(SIGPIPE, SIG_IGN);  // `immerse verify NAME | head -1`: the study still ends with its verdict
+      const int status = run_verify(study, quick);
+      silence_closed_stdout();
+      return status;
+    }
   } catch (const immerse::InputError& e) {
     std::cerr << "immerse: error: " << e.what() << "\n";
     return 2;

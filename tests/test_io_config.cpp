@@ -102,6 +102,7 @@ TEST(Config, UnknownKeysNamedWithSuggestion) {
   EXPECT_EQ(file_error("[fluid]\nmuu = 1\n"), "config run.toml:2:1: unknown key fluid.muu (did you mean fluid.mu?)");
   EXPECT_EQ(file_error("[fluidd]\nmu = 1\n"), "config run.toml:2:1: unknown key fluidd.mu (did you mean fluid.mu?)");
   EXPECT_EQ(file_error("mu = 1\n"), "config run.toml:1:1: unknown key mu (did you mean fluid.mu?)");
+  EXPECT_EQ(file_error("[time]\nmu = 1\n"), "config run.toml:2:1: unknown key time.mu (did you mean fluid.mu?)");
   EXPECT_EQ(file_error("completely_different = 1\n"), "config run.toml:1:1: unknown key completely_different");
   EXPECT_EQ(file_error("[[membrane]]\nlaw.Ess = 1\n"),
             "config run.toml:2:5: unknown key membrane[0].law.Ess (did you mean membrane[0].law.Es?)");

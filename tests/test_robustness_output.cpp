@@ -266,3 +266,48 @@ TEST(RobustnessOutput, FullDiskAfterAnInstabilityStopsWithStatus5) {
       << r.err;
   EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 2) << r.err;
 }
+
+namespace {
+
+/// cell.toml with a mesh file whose copy in the run folder exceeds kLimit, in `scratch`.
+void write_large_mesh_config(const ScratchDir& scratch) {
+  write_gmsh(scratch / "cell.msh", immerse::octahedral_sphere(1), {0.2, 0.2, 0.2});
+  std::ofstream(scratch / "cell.msh", std::ios::app) << "$Comments\n" << std::string(70000, 'x') << "\n$EndComments\n";
+  std::ofstream(scratch / "cell.toml") << file_membrane_toml("cell.msh");
+}
+
+}  // namespace
+
+// An existing folder (a file of the user's in it) whose first run files cannot all be written: the ones written are
+// removed again, exit 2, the folder as it was.
+TEST(RobustnessOutput, ExistingFolderIsLeftAsItWasWhenItsFirstFilesCannotBeWritten) {
+  ScratchDir scratch("output");
+  const fs::path out = scratch / "out";
+  fs::create_directories(out);
+  std::ofstream(out / "notes.txt") << "the user's notes\n";
+  write_large_mesh_config(scratch);
+  const auto before = folder_contents(out);
+  const auto r = run_with_file_size_limit(run_args(scratch / "cell.toml", out, small_run_sets(1)), scratch / "run", kLimit);
+  expect_one_error_line(r, 2, "immerse: error: ",
+                        "cannot write " + (out / "mesh_membrane0.msh").string() + ": File too large");
+  EXPECT_EQ(folder_contents(out), before);
+}
+
+// --overwrite of a folder holding a run, whose new first files cannot all be written: the old run is put back.
+TEST(RobustnessOutput, OverwrittenRunIsPutBackWhenTheNewFirstFilesCannotBeWritten) {
+  ScratchDir scratch("output");
+  const fs::path out = scratch / "out";
+  auto sets = small_membrane_sets(1);
+  sets.push_back("output.fields_every=1");
+  ASSERT_EQ(run_immerse(run_args(scenario_file("oscillating_membrane_quick.toml"), out, sets), scratch / "first").status,
+            0);
+  std::ofstream(out / "notes.txt") << "the user's notes\n";
+  write_large_mesh_config(scratch);
+  const auto before = folder_contents(out);
+  auto args = run_args(scratch / "cell.toml", out, small_run_sets(1));
+  args.push_back("--overwrite");
+  const auto r = run_with_file_size_limit(args, scratch / "run", kLimit);
+  expect_one_error_line(r, 2, "immerse: error: ",
+                        "cannot write " + (out / "mesh_membrane0.msh").string() + ": File too large");
+  EXPECT_EQ(folder_contents(out), before);
+}

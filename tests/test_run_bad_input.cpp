@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstring>
 #include <functional>
+#include <sys/resource.h>
 
 #include "immerse/io/Checkpoint.hpp"
 #include "immerse/membrane/MeshGenerator.hpp"
@@ -140,6 +141,26 @@ class BadInputTest : public ::testing::TestWithParam<BadInput> {
     }
     write_gmsh(dir / "two_cells.msh", two, {0.2, 0.2, 0.2});
     write_gmsh(dir / "cell_mm.msh", cell, {200, 200, 200});
+    // A cigar (semi-axes 1, 0.2, 0.2) bent around the y axis through 8 radians, so that its ends cross (every element
+    // sound on its own), and the cell with its file's origin outside it.
+    Mesh bent = octahedral_sphere(4);
+    for (auto& p : bent.nodes) {
+      const double angle = p.x / 0.25, radius = 0.25 + 0.2 * p.z;
+      p = {radius * std::sin(angle), 0.2 * p.y, radius * std::cos(angle)};
+    }
+    write_gmsh(dir / "bent.msh", bent, {0.8, 0.8, 0.8});
+    Mesh offset = cell;
+    for (auto& p : offset.nodes) p += Vec3{1.5, 0, 0};
+    write_gmsh(dir / "offset.msh", offset, {0.2, 0.2, 0.2});
+
+    // An unknown key in the table of another key ([time] mu), and values of 200 kB and 80 kB.
+    std::string wrong_table = base;
+    wrong_table.replace(wrong_table.find("[time]\n"), 7, "[time]\nmu = 1e-3\n");
+    std::ofstream(dir / "wrong_table.toml") << wrong_table;
+    std::string long_scheme = base;
+    const auto scheme = long_scheme.find("scheme = ");
+    long_scheme.replace(scheme, long_scheme.find('\n', scheme) - scheme, "scheme = \"" + std::string(200000, 'x') + "\"");
+    std::ofstream(dir / "long_scheme.toml") << long_scheme;
   }
   static void TearDownTestSuite() { fs::remove_all(suite_dir()); }
 };
@@ -161,13 +182,33 @@ TEST_P(BadInputTest, ExitsWithStatus2AndOneLineBeforeWritingAnything) {
   EXPECT_EQ(r.err.rfind("immerse: error: ", 0), 0u) << r.err;
   EXPECT_NE(r.err.find(b.message), std::string::npos) << "expected: " << b.message << "\ngot: " << r.err;
   EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+  EXPECT_LT(r.err.size(), 600u) << "a value given is echoed in full";
   EXPECT_FALSE(fs::exists(out)) << "the output folder was created before the input was checked";
+}
+
+std::string long_list(std::size_t count) {
+  std::string list = "[0.5";
+  for (std::size_t i = 1; i < count; ++i) list += ",0.5";
+  return list + "]";
 }
 
 INSTANTIATE_TEST_SUITE_P(
     Run, BadInputTest,
     ::testing::Values(
         BadInput{"unknown_key", "", {"fluid.muu=1"}, "", "unknown key fluid.muu (did you mean fluid.mu?)"},
+        BadInput{"key_in_the_wrong_table", "wrong_table.toml", {}, "", "unknown key time.mu (did you mean fluid.mu?)"},
+        BadInput{"long_value_shortened", "long_scheme.toml", {}, "",
+                 "time.scheme = \"" + std::string(79, 'x') + "... (200002 characters): must be one of"},
+        BadInput{"long_list_shortened", "", {"membrane[0].center=" + long_list(20000)}, "",
+                 "membrane[0].center = " + long_list(20000).substr(0, 80) + "... (80001 characters): must be 3 finite"},
+        BadInput{"long_mesh_file_name_shortened", "file_mesh.toml",
+                 {"membrane[0].mesh.file=\"" + std::string(100000, 'y') + "\""}, "",
+                 "cannot open the file: File name too long"},
+        BadInput{"self_intersecting_membrane", "file_mesh.toml", {"membrane[0].mesh.file=\"SUITE/bent.msh\""}, "",
+                 "membrane[0]: its surface intersects itself (elements "},
+        BadInput{"reference_sphere_about_an_outside_origin", "file_mesh.toml",
+                 {"membrane[0].mesh.file=\"SUITE/offset.msh\"", "membrane[0].reference=\"sphere\""}, "",
+                 "membrane[0].reference = \"sphere\": the origin of mesh.file must lie inside the mesh"},
         BadInput{"wrong_type", "", {"fluid.mu=\"thick\""}, "", "fluid.mu = \"thick\": must be a finite number > 0"},
         BadInput{"out_of_range", "", {"fluid.mu=-1"}, "", "fluid.mu = -1: must be a finite number > 0"},
         BadInput{"not_a_number", "", {"fluid.mu=nan"}, "", "fluid.mu = nan: must be a finite number > 0"},
@@ -358,4 +399,58 @@ TEST(BadInputOptions, EmptyOutputFolderIsRefused) {
                              scratch / "run");
   EXPECT_EQ(r.status, 2) << r.err;
   EXPECT_EQ(r.err, "immerse: error: --out: an empty name was given: must name a folder\n");
+}
+
+// rbc_stretch with contact patches as wide as the cell: the two patches would pull on the same nodes.
+TEST(BadInputScenario, StretchPatchesAsWideAsTheCellAreRefused) {
+  ScratchDir scratch("bad_input");
+  const fs::path out = scratch / "out";
+  const auto r = run_immerse(
+      {"run", scenario_file("rbc_stretch_quick.toml").string(), "--out", out.string(), "--set", "scenario.patch_um=8"},
+      scratch / "run");
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_EQ(r.err,
+            "immerse: error: scenario.patch_um = 8: the contact patches at the two ends of the cell's diameter along x "
+            "(7.82 um) share nodes: must be well below the diameter\n");
+  EXPECT_FALSE(fs::exists(out));
+}
+
+// A grid that needs more memory than the address-space limit (ulimit -v) leaves, while the program itself fits under
+// it: refused before anything is allocated. The limit is set for the child only (inherited through posix_spawn).
+TEST(BadInputMemory, GridBeyondTheAddressSpaceLimitIsRefused) {
+#if defined(__SANITIZE_ADDRESS__)
+  GTEST_SKIP() << "AddressSanitizer reserves terabytes of address space: no program runs under ulimit -v";
+#endif
+  ScratchDir scratch("bad_input");
+  const fs::path out = scratch / "out";
+  auto sets = small_membrane_sets(1);
+  sets.insert(sets.end(), {"grid.nx=256", "grid.ny=256", "grid.nz=256"});  // at least 4.19 GB
+  rlimit saved{};
+  getrlimit(RLIMIT_AS, &saved);
+  rlimit limited = saved;
+  limited.rlim_cur = rlim_t{2} << 30;
+  setrlimit(RLIMIT_AS, &limited);
+  ImmerseProcess p(run_args(scenario_file("oscillating_membrane_quick.toml"), out, sets), scratch / "run");
+  setrlimit(RLIMIT_AS, &saved);
+  EXPECT_EQ(p.wait(), 2) << p.err();
+  const std::string err = p.err();
+  EXPECT_EQ(err.rfind("immerse: error: grid 256 x 256 x 256 = 1.68e+07 cells: needs at least 4.19 GB, more than the ", 0),
+            0u)
+      << err;
+  EXPECT_NE(err.find(" that the address-space limit (ulimit -v = 2.15 GB) leaves this process\n"), std::string::npos)
+      << err;
+  EXPECT_EQ(std::count(err.begin(), err.end(), '\n'), 1) << err;
+  EXPECT_FALSE(fs::exists(out));
+}
+
+// OMP_NUM_THREADS far above the CPUs: one warning line, and the run goes on.
+TEST(RunWarnings, OmpNumThreadsFarAboveTheCpusGivesOneWarningAndRuns) {
+  ScratchDir scratch("bad_input");
+  const fs::path out = scratch / "out";
+  const auto r = run_immerse(run_args(scenario_file("oscillating_membrane_quick.toml"), out, small_membrane_sets(1)),
+                             scratch / "run", {"OMP_NUM_THREADS=1000"});
+  EXPECT_EQ(r.status, 0) << r.err;
+  EXPECT_EQ(r.err.rfind("immerse: warning: OMP_NUM_THREADS = 1000 but ", 0), 0u) << r.err;
+  EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+  EXPECT_TRUE(fs::exists(out / "checkpoint.h5"));
 }

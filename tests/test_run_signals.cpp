@@ -156,3 +156,16 @@ TEST(SignalPipe, ClosedStandardOutputDoesNotStopTheRun) {
   EXPECT_EQ(p.err(), "");
   EXPECT_EQ(io::Checkpoint::read(out / "checkpoint.h5").get_int("step"), 3);
 }
+
+// `immerse verify NAME | head -1` with the reader gone before the first line: the study runs to its verdict (exit 0,
+// all pass) instead of the program dying by SIGPIPE.
+TEST(SignalPipe, ClosedStandardOutputDoesNotKillAVerification) {
+  ScratchDir dir("signal");
+  int fds[2];
+  ASSERT_EQ(pipe(fds), 0);
+  close(fds[0]);
+  ImmerseProcess p({"verify", "fluid_divergence", "--quick"}, dir / "verify", {}, fds[1]);
+  close(fds[1]);
+  EXPECT_EQ(p.wait(), 0) << p.err();
+  EXPECT_EQ(p.err(), "");
+}

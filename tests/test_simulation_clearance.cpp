@@ -1,8 +1,10 @@
 // Clearance checks of an initial configuration (MembraneClearance): the hash-grid search for the closest nodes of
-// two membranes equals a brute-force search (with periodic minimum images), and the winding-number test tells
-// inside from outside of a curved closed membrane.
+// two membranes equals a brute-force search (with periodic minimum images), the winding-number test tells
+// inside from outside of a curved closed membrane, and the self-intersection search finds a folded surface.
 #include <gtest/gtest.h>
 
+#include <chrono>
+#include <cmath>
 #include <random>
 
 #include "immerse/membrane/MeshGenerator.hpp"
@@ -64,4 +66,34 @@ TEST(MembraneClearance, WindingNumberTellsInsideFromOutside) {
   EXPECT_FALSE(encloses(mesh, X, {-5, 0, 0}));
 }
 
+// Sound surfaces (the sphere of the paper's level-4 mesh, 10,242 nodes, and a flattened ellipsoid) do not intersect
+// themselves; the search over the level-4 mesh takes a small part of a run's start.
+TEST(MembraneClearance, SoundSurfacesDoNotIntersectThemselves) {
+  const Mesh sphere = icosahedral_sphere(4);
+  const auto t0 = std::chrono::steady_clock::now();
+  EXPECT_FALSE(self_intersection(sphere, sphere.nodes).has_value());
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  std::cout << "self_intersection of " << sphere.num_nodes() << " nodes: " << seconds << " s\n";
+  EXPECT_LT(seconds, 1.0);
+  std::vector<Vec3> flat;
+  for (const auto& p : octahedral_sphere(3).nodes) flat.push_back({p.x, p.y, 0.05 * p.z});
+  EXPECT_FALSE(self_intersection(octahedral_sphere(3), flat).has_value());
+}
+
+// A cigar bent around an axis until its ends cross; the elements named are the lowest pair.
+TEST(MembraneClearance, SurfaceBentThroughItselfIsFound) {
+  const Mesh mesh = octahedral_sphere(3);
+  std::vector<Vec3> X;
+  for (const auto& p : mesh.nodes) {
+    const double angle = p.x / 0.25, r = 0.25 + 0.2 * p.z;
+    X.push_back({r * std::sin(angle), 0.2 * p.y, r * std::cos(angle)});
+  }
+  const auto pair = self_intersection(mesh, X);
+  ASSERT_TRUE(pair.has_value());
+  EXPECT_LT(pair->first, pair->second);
+  // Moved back, the same mesh is sound again.
+  EXPECT_FALSE(self_intersection(mesh, mesh.nodes).has_value());
+}
+
 }  // namespace
+

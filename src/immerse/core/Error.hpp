@@ -3,6 +3,7 @@
 // what was given and what is allowed.
 #include <stdexcept>
 #include <string>
+#include <string_view>
 
 namespace immerse {
 
@@ -33,6 +34,9 @@ class StopRequested : public std::runtime_error {
  public:
   using std::runtime_error::runtime_error;
 };
+
+/// `text` as a message shows a value given: whole up to 80 characters, else its first 80 and "... (N characters)".
+std::string echoed(std::string_view text);
 
 /// Throws InputError("<name> = <value>: must be <allowed>") unless ok.
 void require(bool ok, const std::string& name, double value, const std::string& allowed);

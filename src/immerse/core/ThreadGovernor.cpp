@@ -97,6 +97,19 @@ ThreadGovernor ThreadGovernor::from_environment() {
   return cpus > 1 ? adaptive(cpus) : ThreadGovernor();
 }
 
+std::string ThreadGovernor::oversubscription_warning() {
+  const char* env = std::getenv("OMP_NUM_THREADS");
+  if (env == nullptr) return "";
+  const long threads = std::strtol(env, nullptr, 10);  // "4,2" (nested levels): the outer count
+  const int cpus = AvailableCpus::of_this_process().count();
+  if (threads <= 2L * cpus) return "";
+  std::ostringstream s;
+  s << "OMP_NUM_THREADS = " << threads << " but " << cpus << (cpus == 1 ? " CPU is" : " CPUs are")
+    << " available: the threads will wait for each other on every step and the run will be much slower than with "
+    << "OMP_NUM_THREADS = " << cpus << " (or unset: chosen by measurement)";
+  return s.str();
+}
+
 std::size_t ThreadGovernor::initial_samples(int i) const {
   return i == 0 ? count_[0] : count_[1] - std::min(count_[1], kWarmup);
 }

@@ -37,6 +37,9 @@ class ThreadGovernor {
   /// The default for a run: fixed when OMP_NUM_THREADS is set (the user's explicit count) or when only one CPU is
   /// available; otherwise adaptive up to the available CPUs.
   static ThreadGovernor from_environment();
+  /// A warning when OMP_NUM_THREADS asks for more than twice the available CPUs (the threads of every parallel loop
+  /// then wait for each other), "" otherwise.
+  static std::string oversubscription_warning();
 
   /// Sets OpenMP's thread count for the next evaluation (omp_set_num_threads) and returns it.
   int choose();

@@ -168,11 +168,14 @@ std::string last_segment(std::string_view k) {
   return std::string(dot == std::string_view::npos ? k : k.substr(dot + 1));
 }
 
-// " (did you mean fluid.mu?)" for the closest declared name, or "" if none is close.
+// " (did you mean fluid.mu?)": a declared name ending in the same key of another table ([time] mu -> fluid.mu), else
+// the closest declared name, or "" if none is close.
 std::string suggestion(const ConfigSchema& s, const std::string& key, const std::string& display) {
   std::vector<std::string> names;
   for (const auto& k : s.keys()) names.push_back(k.key);
   for (const auto& a : s.table_arrays()) names.push_back(a.name);
+  for (const auto& n : names)
+    if (last_segment(n) == last_segment(key)) return " (did you mean " + display + n + "?)";
   std::string best;
   std::size_t best_d = std::string::npos;
   for (const auto& n : names) {
@@ -180,8 +183,6 @@ std::string suggestion(const ConfigSchema& s, const std::string& key, const std:
     if (d < best_d) best_d = d, best = n;
   }
   if (best_d <= std::max<std::size_t>(2, key.size() / 4)) return " (did you mean " + display + best + "?)";
-  for (const auto& n : names)
-    if (last_segment(n) == last_segment(key)) return " (did you mean " + display + n + "?)";
   return "";
 }
 
@@ -201,8 +202,7 @@ std::string given(const toml::node& n) {
   if (const auto* str = n.as_string()) return format_toml(str->get());
   std::ostringstream os;
   n.visit([&](const auto& v) { os << v; });
-  std::string s = one_line(os.str());
-  return s.size() > 60 ? s.substr(0, 57) + "..." : s;
+  return one_line(os.str());
 }
 
 bool as_number(const toml::node& n, double& out) {
@@ -224,7 +224,7 @@ class ConfigResolver {
  public:
   [[noreturn]] static void reject(const std::string& origin, const std::string& name, const std::string& given_text,
                                   const KeySpec& spec) {
-    throw InputError(origin + ": " + name + " = " + given_text + ": must be " + spec.allowed());
+    throw InputError(origin + ": " + name + " = " + echoed(given_text) + ": must be " + spec.allowed());
   }
 
   static ConfigValue convert(const KeySpec& spec, const toml::node& node, const std::string& name,
@@ -287,7 +287,7 @@ class ConfigResolver {
       } else if (const auto* ta = s.find_table_array(key)) {
         const toml::array* a = node.as_array();
         if (!a || !(a->empty() || a->is_array_of_tables()))
-          throw InputError(where(source, node.source()) + ": " + name + " = " + given(node) +
+          throw InputError(where(source, node.source()) + ": " + name + " = " + echoed(given(node)) +
                            ": must be an array of tables [[" + name + "]]");
         auto& entries = out.tables_[key];
         entries.clear();
@@ -308,7 +308,7 @@ class ConfigResolver {
           at = it->first.source();
           n = &it->second;
         }
-        throw InputError(where(source, at) + ": unknown key " + display + full + suggestion(s, full, display));
+        throw InputError(where(source, at) + ": unknown key " + display + echoed(full) + suggestion(s, full, display));
       }
     }
   }
@@ -324,10 +324,11 @@ class ConfigResolver {
 
   static void set(const ConfigSchema& s, Config& cfg, const std::string& assignment, bool given) {
     const auto eq = assignment.find('=');
-    if (eq == std::string::npos) throw InputError("--set " + assignment + ": must be KEY=VALUE");
+    if (eq == std::string::npos) throw InputError("--set " + echoed(assignment) + ": must be KEY=VALUE");
     const std::string key = trim(std::string_view(assignment).substr(0, eq));
     const std::string text = trim(std::string_view(assignment).substr(eq + 1));
-    if (key.empty()) throw InputError("--set " + assignment + ": must be KEY=VALUE (no key given; see --help-config)");
+    if (key.empty())
+      throw InputError("--set " + echoed(assignment) + ": must be KEY=VALUE (no key given; see --help-config)");
 
     const ConfigSchema* schema = &s;
     Config* target = &cfg;
@@ -337,7 +338,7 @@ class ConfigResolver {
       const auto close = key.find(']', br);
       const auto* ta = s.find_table_array(name);
       if (!ta || close == std::string::npos || close + 2 > key.size() || key[close + 1] != '.')
-        throw InputError("--set: unknown key " + key + suggestion(s, name, ""));
+        throw InputError("--set: unknown key " + echoed(key) + suggestion(s, name, ""));
       const std::string idx_text = key.substr(br + 1, close - br - 1);
       auto& entries = cfg.tables_[name];
       std::size_t idx = 0;
@@ -345,7 +346,7 @@ class ConfigResolver {
                           std::all_of(idx_text.begin(), idx_text.end(), [](char c) { return c >= '0' && c <= '9'; });
       if (digits) idx = std::stoul(idx_text);
       if (!digits || idx > entries.size())
-        throw InputError("--set: " + key + ": index " + idx_text + " given: must be in [0, " +
+        throw InputError("--set: " + echoed(key) + ": index " + echoed(idx_text) + " given: must be in [0, " +
                          std::to_string(entries.size()) + "] (" + std::to_string(entries.size()) +
                          " adds an entry)");
       if (idx == entries.size()) entries.emplace_back(Config(ta->entry));
@@ -355,7 +356,7 @@ class ConfigResolver {
       rel = key.substr(close + 2);
     }
     const KeySpec* spec = schema->find(rel);
-    if (!spec) throw InputError("--set: unknown key " + key + suggestion(*schema, rel, display));
+    if (!spec) throw InputError("--set: unknown key " + echoed(key) + suggestion(*schema, rel, display));
 
     // String keys take bare text (--set time.scheme=jfnk) as well as TOML strings.
     if (spec->kind == KeySpec::Kind::String && (text.empty() || (text[0] != '"' && text[0] != '\''))) {

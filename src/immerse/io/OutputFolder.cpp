@@ -92,4 +92,38 @@ int OutputFolder::remove_temporaries() const {
   return removed;
 }
 
+void OutputFolder::keep_run_files() {
+  kept_ = dir_ / (".immerse_kept." + std::to_string(::getpid()));
+  std::error_code ec;
+  std::filesystem::remove_all(kept_, ec);
+  if (!std::filesystem::create_directory(kept_, ec) || ec) {
+    kept_.clear();
+    throw WriteError("cannot write " + dir_.string() + ": " + (ec ? ec.message() : "cannot create a folder in it"));
+  }
+  for (const auto& name : run_files()) {
+    if (::link((dir_ / name).c_str(), (kept_ / name).c_str()) != 0)
+      std::filesystem::copy_file(dir_ / name, kept_ / name, ec);
+    if (ec) {
+      drop_kept();
+      throw WriteError("cannot write " + (dir_ / name).string() + ": cannot keep it until the run's first files are " +
+                       "written: " + ec.message());
+    }
+  }
+}
+
+void OutputFolder::restore_kept() {
+  for (const auto& name : run_files()) ::unlink((dir_ / name).c_str());
+  if (kept_.empty()) return;
+  std::error_code ec;
+  for (const auto& e : std::filesystem::directory_iterator(kept_, ec))
+    ::rename(e.path().c_str(), (dir_ / e.path().filename()).c_str());
+  drop_kept();
+}
+
+void OutputFolder::drop_kept() {
+  std::error_code ec;
+  if (!kept_.empty()) std::filesystem::remove_all(kept_, ec);
+  kept_.clear();
+}
+
 }  // namespace immerse::io

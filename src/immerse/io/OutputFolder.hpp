@@ -30,12 +30,19 @@ class OutputFolder {
   void remove_run_files() const;
   /// Removes the temporaries left by a writer that was killed; returns how many.
   int remove_temporaries() const;
+  /// Keeps the run files now in the folder, as hard links (copies where the file system has none) in
+  /// DIR/.immerse_kept.PID, so that restore_kept() can put the folder back as it was (WriteError on failure).
+  void keep_run_files();
+  /// Removes the run files and puts the kept ones back (best effort: this undoes a failed write).
+  void restore_kept();
+  /// Removes the kept files: the run has written its first files.
+  void drop_kept();
 
   static bool is_run_file(const std::string& name);
   static bool is_temporary(const std::string& name);
 
  private:
-  std::filesystem::path dir_;
+  std::filesystem::path dir_, kept_;
   int fd_ = -1;
   bool created_ = false;
 };

@@ -71,7 +71,7 @@ class Parser {
     const auto e = s.find_last_not_of(" \t\r\n");
     return b == std::string::npos ? std::string() : s.substr(b, e - b + 1);
   }
-  [[noreturn]] void fail(const std::string& what) const { throw InputError("mesh " + label_ + ": " + what); }
+  [[noreturn]] void fail(const std::string& what) const { throw InputError("mesh " + echoed(label_) + ": " + what); }
   void require_format(bool have) const {
     if (!have) fail("section before $MeshFormat");
   }
@@ -248,7 +248,7 @@ class Parser {
       }
     }
     orient_outward_if_finite(mesh);
-    validate_closed_mesh(mesh, label_, ids);
+    validate_closed_mesh(mesh, echoed(label_), ids);
     return mesh;
   }
 
@@ -273,8 +273,9 @@ Mesh read_gmsh(std::istream& in, const std::string& label) { return Parser(in, l
 
 Mesh read_gmsh(const std::string& path) {
   std::ifstream in(path);
-  if (!in) throw InputError("mesh " + path + ": cannot open the file: " + std::strerror(errno));
-  if (std::filesystem::is_directory(path)) throw InputError("mesh " + path + ": cannot open the file: it is a directory");
+  if (!in) throw InputError("mesh " + echoed(path) + ": cannot open the file: " + std::strerror(errno));
+  if (std::filesystem::is_directory(path))
+    throw InputError("mesh " + echoed(path) + ": cannot open the file: it is a directory");
   return read_gmsh(in, path);
 }
 

@@ -1,6 +1,7 @@
 #include "immerse/simulation/MembraneClearance.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <numbers>
 #include <tuple>
@@ -92,6 +93,99 @@ bool encloses(const Mesh& mesh, const std::vector<Vec3>& X, const Vec3& p) {
     omega += solid_angle(e[0], e[3], e[5]) + solid_angle(e[3], e[1], e[4]) + solid_angle(e[5], e[4], e[2]) +
              solid_angle(e[3], e[4], e[5]);
   return omega > 2 * std::numbers::pi;  // 4π inside, 0 outside
+}
+
+namespace {
+
+// Which side of the plane through a, b, c the point d lies on (sign of the tetrahedron's volume).
+int side(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d) {
+  const double v = dot(cross(b - a, c - a), d - a);
+  return (v > 0) - (v < 0);
+}
+
+// Whether the segment pq passes through the interior of triangle abc (touching does not count).
+bool crosses(const Vec3& p, const Vec3& q, const Vec3& a, const Vec3& b, const Vec3& c) {
+  const int sp = side(a, b, c, p), sq = side(a, b, c, q);
+  if (sp == 0 || sq == 0 || sp == sq) return false;
+  const int s = side(p, q, a, b);
+  return s != 0 && side(p, q, b, c) == s && side(p, q, c, a) == s;
+}
+
+}  // namespace
+
+std::optional<std::pair<std::size_t, std::size_t>> self_intersection(const Mesh& mesh, const std::vector<Vec3>& X) {
+  struct Triangle {
+    std::array<int, 3> n;
+    std::size_t element;
+    Vec3 lo, hi;
+  };
+  std::vector<Triangle> tris;
+  double largest = 0, sum = 0;
+  for (std::size_t e = 0; e < mesh.elements.size(); ++e) {
+    const auto& el = mesh.elements[e];
+    for (const std::array<int, 3> n : {std::array<int, 3>{el[0], el[3], el[5]}, std::array<int, 3>{el[3], el[1], el[4]},
+                                       std::array<int, 3>{el[5], el[4], el[2]}, std::array<int, 3>{el[3], el[4], el[5]}}) {
+      Triangle t{n, e, X[n[0]], X[n[0]]};
+      for (int v : n)
+        for (int k = 0; k < 3; ++k) t.lo[k] = std::min(t.lo[k], X[v][k]), t.hi[k] = std::max(t.hi[k], X[v][k]);
+      const double extent = std::max({t.hi[0] - t.lo[0], t.hi[1] - t.lo[1], t.hi[2] - t.lo[2]});
+      largest = std::max(largest, extent);
+      sum += extent;
+      tris.push_back(t);
+    }
+  }
+  if (tris.empty() || !(largest > 0)) return std::nullopt;
+  // Cells twice a typical triangle's box, so that most triangles lie in 2 x 2 x 2 of them and the largest in at most
+  // 17 x 17 x 17. A pair is tested in the cell holding the low corner of the intersection of their boxes only.
+  const double cell = std::max(2 * sum / double(tris.size()), largest / 16);
+  Vec3 origin = tris[0].lo;
+  for (const auto& t : tris)
+    for (int k = 0; k < 3; ++k) origin[k] = std::min(origin[k], t.lo[k]);
+  const auto cell_of = [&](const Vec3& p) {
+    std::array<long, 3> c{};
+    for (int k = 0; k < 3; ++k) c[k] = static_cast<long>(std::floor((p[k] - origin[k]) / cell));
+    return c;
+  };
+  const auto key = [](const std::array<long, 3>& c) { return (c[0] * 4096 + c[1]) * 4096 + c[2]; };
+  std::vector<std::pair<long, std::size_t>> binned;
+  for (std::size_t i = 0; i < tris.size(); ++i) {
+    const auto a = cell_of(tris[i].lo), b = cell_of(tris[i].hi);
+    for (long x = a[0]; x <= b[0]; ++x)
+      for (long y = a[1]; y <= b[1]; ++y)
+        for (long z = a[2]; z <= b[2]; ++z) binned.emplace_back(key({x, y, z}), i);
+  }
+  std::sort(binned.begin(), binned.end());
+  std::optional<std::pair<std::size_t, std::size_t>> found;
+  const auto cross_each_other = [&](const Triangle& s, const Triangle& t) {
+    for (int i = 0; i < 3; ++i) {
+      if (crosses(X[s.n[i]], X[s.n[(i + 1) % 3]], X[t.n[0]], X[t.n[1]], X[t.n[2]])) return true;
+      if (crosses(X[t.n[i]], X[t.n[(i + 1) % 3]], X[s.n[0]], X[s.n[1]], X[s.n[2]])) return true;
+    }
+    return false;
+  };
+  for (std::size_t begin = 0; begin < binned.size();) {
+    std::size_t end = begin;
+    while (end < binned.size() && binned[end].first == binned[begin].first) ++end;
+    for (std::size_t i = begin; i < end; ++i)
+      for (std::size_t j = i + 1; j < end; ++j) {
+        const Triangle &s = tris[binned[i].second], &t = tris[binned[j].second];
+        if (s.element == t.element) continue;
+        Vec3 lo;
+        bool overlap = true;
+        for (int k = 0; k < 3; ++k) {
+          lo[k] = std::max(s.lo[k], t.lo[k]);
+          overlap = overlap && lo[k] <= std::min(s.hi[k], t.hi[k]);
+        }
+        if (!overlap || key(cell_of(lo)) != binned[begin].first) continue;
+        bool shared = false;
+        for (int a : s.n) shared = shared || std::find(t.n.begin(), t.n.end(), a) != t.n.end();
+        if (shared || !cross_each_other(s, t)) continue;
+        const std::pair<std::size_t, std::size_t> pair = std::minmax(s.element, t.element);
+        if (!found || pair < *found) found = pair;
+      }
+    begin = end;
+  }
+  return found;
 }
 
 }  // namespace immerse

@@ -6,8 +6,11 @@
 // are minimum images. The nodes are binned in a hash grid of cell size `reach`, so the search is linear in the
 // number of nodes. Closed surfaces with no close nodes are either apart or nested; `encloses` tells which by the
 // winding number of the surface around a point (the solid angles of the four flat sub-triangles of each six-node
-// element, Van Oosterom & Strackee 1983), which is 1 inside and 0 outside.
+// element, Van Oosterom & Strackee 1983), which is 1 inside and 0 outside. `self_intersection` finds two elements of
+// one surface that cross: the flat sub-triangles are binned in a hash grid, and those of different elements that share
+// no node are tested for an edge of one passing through the other (signs of tetrahedron volumes).
 #include <optional>
+#include <utility>
 #include <vector>
 
 #include "immerse/core/Vec3.hpp"
@@ -27,6 +30,9 @@ std::optional<NodePairGap> closest_foreign_nodes(const Grid& grid, const std::ve
 
 /// Vector from b to a, by the minimum image along the grid's periodic axes.
 Vec3 minimum_image(const Grid& grid, const Vec3& a, const Vec3& b);
+
+/// Two elements (lower index first) whose flat sub-triangles cross, the lowest such pair; nullopt if none do.
+std::optional<std::pair<std::size_t, std::size_t>> self_intersection(const Mesh& mesh, const std::vector<Vec3>& X);
 
 /// Winding number test: true when p lies inside the closed surface `mesh` at positions X.
 bool encloses(const Mesh& mesh, const std::vector<Vec3>& X, const Vec3& p);

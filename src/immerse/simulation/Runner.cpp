@@ -1,7 +1,9 @@
 #include "immerse/simulation/Runner.hpp"
 
+#include <sys/resource.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <array>
 #include <chrono>
 #include <cmath>
@@ -176,18 +178,79 @@ std::string grid_text(const io::Config& c) {
          std::to_string(c.get<int>("grid.nz"));
 }
 
-// A grid far beyond the machine's memory is refused before anything is allocated (the operating system would
+std::string gigabytes(double bytes) {
+  std::ostringstream s;
+  s << std::setprecision(3) << std::max(bytes, 0.0) / 1e9 << " GB";
+  return s.str();
+}
+
+struct MemoryLimit {
+  double bytes;
+  std::string what;  // e.g. "this machine's memory (25.3 GB)"
+};
+
+// The smallest memory limit of the cgroup at `dir` (relative to the hierarchy mounted at `root`) and its ancestors,
+// read from `file` (cgroup v2 memory.max, "max" meaning none; v1 memory.limit_in_bytes, huge meaning none).
+std::optional<MemoryLimit> cgroup_memory_limit(const std::string& root, std::string dir, const std::string& file) {
+  std::optional<MemoryLimit> limit;
+  while (true) {
+    std::ifstream in(root + dir + "/" + file);
+    std::string text;
+    if (in >> text && text != "max") {
+      const double bytes = std::strtod(text.c_str(), nullptr);
+      if (bytes > 0 && bytes < 1e18 && (!limit || bytes < limit->bytes))
+        limit = MemoryLimit{bytes, "the cgroup memory limit (" + gigabytes(bytes) + ", " + root + dir + "/" + file + ")"};
+    }
+    if (dir.empty() || dir == "/") break;
+    dir = dir.substr(0, dir.find_last_of('/'));
+  }
+  return limit;
+}
+
+// The memory a run may use: the smallest of the physical memory, the cgroup memory limit (v2 or v1) of this
+// process and what the address-space limit (ulimit -v) leaves beside the address space already mapped.
+std::vector<MemoryLimit> memory_limits() {
+  std::vector<MemoryLimit> limits;
+  if (const double memory = double(sysconf(_SC_PHYS_PAGES)) * double(sysconf(_SC_PAGESIZE)); memory > 0)
+    limits.push_back({memory, "this machine's memory (" + gigabytes(memory) + ")"});
+  if (rlimit as{}; getrlimit(RLIMIT_AS, &as) == 0 && as.rlim_cur != RLIM_INFINITY) {
+    double mapped_pages = 0;
+    std::ifstream("/proc/self/statm") >> mapped_pages;
+    const double left = double(as.rlim_cur) - mapped_pages * double(sysconf(_SC_PAGESIZE));
+    limits.push_back({left, "the " + gigabytes(left) + " that the address-space limit (ulimit -v = " +
+                                gigabytes(double(as.rlim_cur)) + ") leaves this process"});
+  }
+  // /proc/self/cgroup: "0::/path" (v2) or "N:...memory...:/path" (v1).
+  std::ifstream in("/proc/self/cgroup");
+  for (std::string line; std::getline(in, line);) {
+    const auto a = line.find(':'), b = line.find(':', a + 1);
+    if (a == std::string::npos || b == std::string::npos) continue;
+    const std::string controllers = line.substr(a + 1, b - a - 1), path = line.substr(b + 1);
+    std::optional<MemoryLimit> limit;
+    if (controllers.empty())
+      limit = cgroup_memory_limit("/sys/fs/cgroup", path, "memory.max");
+    else if (("," + controllers + ",").find(",memory,") != std::string::npos)
+      limit = cgroup_memory_limit("/sys/fs/cgroup/memory", path, "memory.limit_in_bytes");
+    if (limit) limits.push_back(*limit);
+  }
+  return limits;
+}
+
+// A grid beyond the memory the run may use is refused before anything is allocated (the operating system would
 // otherwise grant the memory and kill the run when it is touched). kBytesPerCell is a lower bound: the peak
 // resident memory of a run grows by about 300 bytes per cell (16^3 -> 64^3, frames and checkpoints written; measured
 // before the fast solvers tabulated their inverse symbols, 32 bytes per cell more).
 void check_memory(const io::Config& c) {
   constexpr double kBytesPerCell = 250;
   const double cells = double(c.get<int>("grid.nx")) * c.get<int>("grid.ny") * c.get<int>("grid.nz");
-  const double memory = double(sysconf(_SC_PHYS_PAGES)) * double(sysconf(_SC_PAGESIZE));
-  if (memory > 0 && cells * kBytesPerCell > memory) {
+  const auto limits = memory_limits();
+  if (limits.empty()) return;
+  const MemoryLimit& limit = *std::min_element(
+      limits.begin(), limits.end(), [](const MemoryLimit& a, const MemoryLimit& b) { return a.bytes < b.bytes; });
+  if (cells * kBytesPerCell > limit.bytes) {
     std::ostringstream s;
     s << std::setprecision(3) << grid_text(c) << " = " << cells << " cells: needs at least "
-      << cells * kBytesPerCell / 1e9 << " GB, this machine has " << memory / 1e9 << " GB";
+      << gigabytes(cells * kBytesPerCell) << ", more than " << limit.what;
     throw InputError(s.str());
   }
 }
@@ -312,7 +375,11 @@ int run_command(const RunOptions& options, std::ostream& out, std::ostream& err)
     }
   }
 
-  // 3. Output. A folder this run created is removed again if its first files cannot be written.
+  if (const std::string warning = ThreadGovernor::oversubscription_warning(); !warning.empty())
+    err << "immerse: warning: " << warning << std::endl;
+
+  // 3. Output. If its first files cannot be written, a folder this run created is removed again and an existing one
+  // is put back as it was.
   io::Provenance provenance = io::Provenance::now(
       options.command_line.empty() ? "immerse run " + options.file.string() : options.command_line,
       sim.op().thread_governor().policy());
@@ -321,6 +388,7 @@ int run_command(const RunOptions& options, std::ostream& out, std::ostream& err)
                                 io::format_number(sim.time()) + (in_place ? " (continued)" : " (branched)");
   std::optional<io::XdmfWriter> frames_opt;
   std::optional<io::CsvWriter> csv_opt, stretch;
+  folder.keep_run_files();  // until the first files are written: a failure leaves the folder as it was
   try {
     frames_opt.emplace(dir, first_frame);  // a restart reads back the frames before the checkpoint first
     frames_opt->set_attributes(provenance.attributes());
@@ -345,9 +413,10 @@ int run_command(const RunOptions& options, std::ostream& out, std::ostream& err)
     csv_opt.emplace(dir / "diagnostics.csv", columns, mode);
     if (sweep) stretch.emplace(dir / "stretch.csv", stretch_columns, mode);
   } catch (const WriteError&) {
-    if (folder.created()) folder.remove_run_files();
+    folder.restore_kept();
     throw;
   }
+  folder.drop_kept();
   io::CsvWriter& csv = *csv_opt;
   io::XdmfWriter& frames = *frames_opt;
   if (sweep)

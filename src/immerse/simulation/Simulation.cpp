@@ -184,6 +184,9 @@ void Simulation::build_membranes() {
         initial = placed(mesh);
         const std::string kind = m.get<std::string>("reference");
         if (kind == "sphere") {
+          if (!encloses(mesh, mesh.nodes, Vec3{0, 0, 0}))
+            throw InputError("reference = \"sphere\": the origin of mesh.file must lie inside the mesh (the reference "
+                             "sphere maps each node's direction from it: the mesh must be star-shaped about its origin)");
           std::vector<Vec3> unit;
           for (const auto& p : mesh.nodes) unit.push_back(normalized(p));
           reference = map_sphere(shape_of(m, true), unit);
@@ -308,6 +311,9 @@ void Simulation::check_geometry() const {
         throw InputError(s.str());
       }
     }
+    if (const auto pair = self_intersection(meshes_[m], X))
+      throw InputError(membrane_name(m) + ": its surface intersects itself (elements " + std::to_string(pair->first) +
+                       " and " + std::to_string(pair->second) + ")");
     const double d = min_wall_distance(grid_, X);
     if (d < h) {
       std::ostringstream s;

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <sstream>
 
 #include "immerse/core/Error.hpp"
 
@@ -26,6 +27,16 @@ StretchSweep::StretchSweep(const Simulation& sim) {
   }
   if (left_.empty() || right_.empty())
     throw InputError("scenario.patch_um = " + std::to_string(2e6 * r) + ": the contact patches hold no mesh node");
+  const bool shared = std::any_of(left_.begin(), left_.end(), [&](std::size_t i) { return norm(ref[i] - *hi) <= r; });
+  if (shared || 2 * (left_.size() + right_.size()) > nodes_) {
+    std::ostringstream s;
+    s << "scenario.patch_um = " << 2e6 * r << ": the contact patches at the two ends of the cell's diameter along x ("
+      << (hi->x - lo->x) * 1e6 << " um) "
+      << (shared ? "share nodes" : "cover " + std::to_string(left_.size() + right_.size()) + " of its " +
+                                       std::to_string(nodes_) + " nodes, more than half")
+      << ": must be well below the diameter";
+    throw InputError(s.str());
+  }
 }
 
 std::vector<Vec3> StretchSweep::nodal_loads(double F) const {

@@ -64,13 +64,13 @@ SnesIntegrator::~SnesIntegrator() {
 
 void SnesIntegrator::insert_options(PetscOptions options, const char* source, const std::string& text) {
   if (!text.empty() && PetscOptionsInsertString(options, text.c_str()) != 0)
-    throw InputError(std::string(source) + " = '" + text + "': PETSc cannot parse it");
+    throw InputError(std::string(source) + " = '" + echoed(text) + "': PETSc cannot parse it");
 }
 
 std::string SnesIntegrator::options_given() const {
-  std::string s = environment_options_.empty() ? "" : "PETSC_OPTIONS = '" + environment_options_ + "'";
+  std::string s = environment_options_.empty() ? "" : "PETSC_OPTIONS = '" + echoed(environment_options_) + "'";
   if (s.empty() || !settings_.petsc_options.empty())
-    s += (s.empty() ? "" : ", ") + std::string("solver.petsc_options = '") + settings_.petsc_options + "'";
+    s += (s.empty() ? "" : ", ") + std::string("solver.petsc_options = '") + echoed(settings_.petsc_options) + "'";
   return s;
 }
 
@@ -94,7 +94,7 @@ void SnesIntegrator::check_options_used() {
     PetscOptionsUsed(nullptr, n.c_str(), &read_at_start);
     if (!in_config && read_at_start) continue;
     std::string& list = in_config ? from_config : from_environment;
-    list += (list.empty() ? "" : ", ") + option;
+    list += (list.empty() ? "" : ", ") + echoed(option);
     ++count;
   }
   PetscOptionsDestroy(&config);
