@@ -8,12 +8,14 @@
 #include "immerse/core/Error.hpp"
 #include "immerse/fluid/PoiseuilleFlow.hpp"
 #include "immerse/coupling/NodeDiagnostics.hpp"
+#include "immerse/membrane/Geometry.hpp"
 #include "immerse/membrane/GmshReader.hpp"
 #include "immerse/membrane/MeshGenerator.hpp"
 #include "immerse/membrane/MeshValidation.hpp"
 #include "immerse/membrane/NeoHookean.hpp"
 #include "immerse/membrane/Shape.hpp"
 #include "immerse/membrane/Skalak.hpp"
+#include "immerse/membrane/VolumeCorrection.hpp"
 #include "immerse/membrane/Yeoh.hpp"
 #include "immerse/simulation/MembraneClearance.hpp"
 #include "immerse/simulation/Scenario.hpp"
@@ -204,7 +206,11 @@ void Simulation::build_membranes() {
                                                      : ReferenceCurvature::Zero};
       membranes_.push_back(std::make_unique<ElasticMembrane>(
           mesh, reference, law_of(m), bending,
-          m.get<std::string>("force") == "energy" ? ForceMethod::Energy : ForceMethod::Contour));
+          m.get<std::string>("force") == "energy" ? ForceMethod::Energy : ForceMethod::Contour,
+          ConstraintModuli{m.get<double>("volume_modulus"), m.get<double>("area_modulus")}));
+      corrected_volume_.push_back(m.get<std::string>("volume_correction") == "normal_shift"
+                                      ? std::optional<double>(volume(mesh, initial))
+                                      : std::nullopt);
       meshes_.push_back(std::move(mesh));
       references_.push_back(std::move(reference));
       initial_.push_back(std::move(initial));
@@ -318,6 +324,16 @@ StepRecord Simulation::advance(const std::function<void(const std::string&)>& lo
     r.stats = acc.stats;
     r.dt = acc.dt;
     r.rejected = acc.rejected;
+    for (std::size_t m = 0; m < corrected_volume_.size(); ++m) {
+      if (!corrected_volume_[m]) continue;
+      auto X = op_->membrane_positions(m);
+      try {
+        normal_shift(meshes_[m], X, *corrected_volume_[m]);
+      } catch (const SimulationError& e) {
+        throw SimulationError(membrane_name(m) + " " + e.what());
+      }
+      op_->correct_positions(m, X);
+    }
   } catch (const SimulationError& e) {
     throw SimulationError(where.str() + e.what());
   }
