@@ -166,7 +166,7 @@ ElasticMembrane::Work& ElasticMembrane::workspace() {
 }
 
 ElasticMembrane::ElasticMembrane(const Mesh& mesh, std::vector<Vec3> reference, MaterialLaw law, Bending bending,
-                                 ForceMethod method)
+                                 ForceMethod method, ConstraintModuli constraint)
     : elements_(mesh.elements), reference_(std::move(reference)), law_(std::move(law)), bending_(bending),
       method_(method) {
   const std::size_t N = reference_.size(), E = elements_.size();
@@ -213,6 +213,7 @@ ElasticMembrane::ElasticMembrane(const Mesh& mesh, std::vector<Vec3> reference, 
   if (bending_.kappa_B > 0) fit_.emplace(mesh, reference_);
   kappa_ref_ = fit_ && bending_.reference == ReferenceCurvature::RestShape ? reference_mean_curvature()
                                                                           : std::vector<double>(N, 0.0);
+  if (constraint.volume != 0 || constraint.area != 0) constraint_.emplace(mesh, mesh.nodes, constraint);
 }
 
 void ElasticMembrane::check_size(const std::vector<Vec3>& X) const {
@@ -409,6 +410,7 @@ void ElasticMembrane::compute_force(const std::vector<Vec3>& X, std::vector<Vec3
     }
     F[i] = s;
   }
+  if (constraint_) constraint_->add_force(X, F);
 }
 
 
@@ -519,7 +521,7 @@ std::size_t ElasticMembrane::memory_bytes() const {
   const std::size_t persistent = E * sizeof(std::array<int, 6>) + N * sizeof(Vec3) +
                                  (inc_start_.size() + inc_.size()) * sizeof(int) +
                                  (ref_node_.size() + ref_quad_.size() + kappa_ref_.size()) * sizeof(double) +
-                                 (fit_ ? fit_->memory_bytes() : 0);
+                                 (fit_ ? fit_->memory_bytes() : 0) + (constraint_ ? constraint_->memory_bytes() : 0);
   // Workspace of compute_force (kept per calling thread): per node and per element node n, and tau (eq. 42
   // tension) or N, kappa, m and q (bending); per element F_e and the lumping fractions (eq. 42); the energy
   // method's per-element-node forces.

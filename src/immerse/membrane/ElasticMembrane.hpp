@@ -12,6 +12,8 @@
 //   ForceMethod::Energy   F_i = -dE/dX_i of E = sum_e sum_gp W(A1, A2) Jbar w (6-point rule on each curved
 //                         element, A from the element's own interpolation): exact linear and angular momentum.
 //                         Bending (if kappa_B > 0) is added as the q-part of eq. (42); E holds no bending energy.
+// Optionally the global volume and area constraints of VolumeAreaConstraint are added to either (exact -dE/dX of
+// their penalty energies about the volume and area of mesh.nodes; docs/volume-conservation.md).
 // See docs/membrane-bending.md for the derivations, the lumping rule and the two deviations from the paper
 // (element-node tensions, not deformation gradients, are averaged at nodes; nodal curvature by a local fit
 // instead of averaging the element-wise (40), so that the nodal bending load converges).
@@ -23,6 +25,7 @@
 #include "immerse/membrane/CurvatureFit.hpp"
 #include "immerse/membrane/MaterialLaw.hpp"
 #include "immerse/membrane/Mesh.hpp"
+#include "immerse/membrane/VolumeAreaConstraint.hpp"
 
 namespace immerse {
 
@@ -46,15 +49,17 @@ struct NodeStrain {
 class ElasticMembrane {
  public:
   /// `reference` holds the unstressed positions Xbar (indexed like mesh.nodes). InputError on size mismatch,
-  /// bad element indices, kappa_B < 0 or a degenerate reference element.
+  /// bad element indices, kappa_B < 0, a negative constraint modulus or a degenerate reference element. The
+  /// constraints (if any modulus > 0) hold the volume and area of mesh.nodes (in a run: the initial shape).
   ElasticMembrane(const Mesh& mesh, std::vector<Vec3> reference, MaterialLaw law, Bending bending,
-                  ForceMethod method);
+                  ForceMethod method, ConstraintModuli constraint = {});
 
-  /// Nodal forces F (N) exerted by the membrane at positions X (resized to the node count). Thread-safe for
+  /// Nodal forces F (N) exerted by the membrane at positions X (resized to the node count), constraint forces
+  /// included. Thread-safe for
   /// concurrent calls; OpenMP inside; independent of the thread count. SimulationError naming the element if
   /// one inverts or degenerates (Jacobian <= 0 or not finite).
   void compute_force(const std::vector<Vec3>& X, std::vector<Vec3>& F) const;
-  /// Discrete in-plane elastic energy E (J) = sum_e sum_gp W(A1, A2) Jbar w.
+  /// Discrete in-plane elastic energy E (J) = sum_e sum_gp W(A1, A2) Jbar w (without the constraints' energy).
   double compute_energy(const std::vector<Vec3>& X) const;
 
   /// Strain and tension at each node: invariants A1, A2 at the element nodes averaged over the elements sharing
@@ -71,6 +76,8 @@ class ElasticMembrane {
   std::size_t num_nodes() const { return reference_.size(); }
   std::size_t num_elements() const { return elements_.size(); }
   ForceMethod method() const { return method_; }
+  /// The global volume and area constraints, when a modulus is > 0.
+  const std::optional<VolumeAreaConstraint>& constraint() const { return constraint_; }
   /// Bytes held by this object (reference data, incidence) plus the workspace compute_force keeps per calling
   /// thread.
   std::size_t memory_bytes() const;
@@ -98,6 +105,7 @@ class ElasticMembrane {
   std::vector<double> kappa_ref_;
   bool threaded_ = false;  ///< large enough for OpenMP threads (kMinElementsForThreads)
   std::optional<CurvatureFit> fit_;  ///< nodal normal and curvature for the bending moments (kappa_B > 0)
+  std::optional<VolumeAreaConstraint> constraint_;
 };
 
 }  // namespace immerse

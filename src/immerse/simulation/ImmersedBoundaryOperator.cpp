@@ -231,6 +231,19 @@ void ImmersedBoundaryOperator::set_applied_forces(std::size_t m, const std::vect
   start_valid_ = false;
 }
 
+void ImmersedBoundaryOperator::correct_positions(std::size_t m, const std::vector<Vec3>& X) {
+  const std::size_t n = offset_[m + 1] - offset_[m];
+  if (X.size() != n) throw std::logic_error("correct_positions: one position per node");
+  std::copy(X.begin(), X.end(), X_.begin() + static_cast<std::ptrdiff_t>(offset_[m]));
+  timed(timings_.interpolate, Phase::Interpolation, [&] {
+    coupler_.interpolate_velocity(committed_.u, std::span<const Vec3>(X_).subspan(offset_[m], n),
+                                  std::span<Vec3>(U_).subspan(offset_[m], n));
+  });
+  trial_X_.clear();
+  trial_U_valid_ = false;
+  start_valid_ = false;
+}
+
 double ImmersedBoundaryOperator::min_wall_distance() const { return immerse::min_wall_distance(fluid_.grid(), X_); }
 
 }  // namespace immerse

@@ -59,6 +59,10 @@ class ImmersedBoundaryOperator final : public CoupledOperator {
   std::vector<Vec3> membrane_positions(std::size_t m) const;
   /// Committed node velocities of membrane m.
   std::vector<Vec3> membrane_velocities(std::size_t m) const;
+  /// Replaces the committed positions of membrane m by X after an accepted step (a correction such as
+  /// VolumeCorrection's normal shift): its node velocities become J(X) u^n of the committed fluid, which is not
+  /// changed, and the next step's start force S(X^n) f(X^n) is computed at the new positions.
+  void correct_positions(std::size_t m, const std::vector<Vec3>& X);
   /// Smallest distance of any node to a wall (infinity without walls).
   double min_wall_distance() const;
   /// External nodal forces (N) on membrane m, added to its elastic force from now on (e.g. optical tweezers,

@@ -54,6 +54,15 @@ ConfigSchema membrane_schema() {
                "reference mean curvature of eq. (25): zero (flat rest state, §4.2.3) or that of the reference shape");
   m.add_string("force", "contour", {"contour", "energy"},
                "nodal forces by the contour integral of eq. (42), or energy-consistent -dE/dX");
+  m.add_double("volume_modulus", 0.0, Range::non_negative(),
+               "k_V of the global volume constraint E_V = k_V (V - V0)^2 / (2 V0), V0 the initial volume (Pa: k_V dV/V0 "
+               "is the pressure jump it adds); 0 switches it off (docs/volume-conservation.md)");
+  m.add_double("area_modulus", 0.0, Range::non_negative(),
+               "k_A of the global area constraint E_A = k_A (A - A0)^2 / (2 A0), A0 the initial area (N/m: k_A dA/A0 "
+               "is the isotropic tension it adds); 0 switches it off");
+  m.add_string("volume_correction", "none", {"none", "normal_shift"},
+               "after each accepted step: nothing, or move all nodes along their normals by one common distance "
+               "that restores the initial volume exactly (the fluid is not changed; docs/volume-conservation.md)");
   return m;
 }
 

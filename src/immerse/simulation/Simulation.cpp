@@ -16,6 +16,7 @@
 #include "immerse/membrane/NeoHookean.hpp"
 #include "immerse/membrane/Shape.hpp"
 #include "immerse/membrane/Skalak.hpp"
+#include "immerse/membrane/VolumeCorrection.hpp"
 #include "immerse/membrane/Yeoh.hpp"
 #include "immerse/simulation/CellPacking.hpp"
 #include "immerse/simulation/MembraneClearance.hpp"
@@ -222,7 +223,11 @@ void Simulation::add_membrane(const io::Config& m, Mesh mesh, std::vector<Vec3> 
                                                  : ReferenceCurvature::Zero};
   membranes_.push_back(std::make_unique<ElasticMembrane>(
       mesh, reference, law_of(m), bending,
-      m.get<std::string>("force") == "energy" ? ForceMethod::Energy : ForceMethod::Contour));
+      m.get<std::string>("force") == "energy" ? ForceMethod::Energy : ForceMethod::Contour,
+      ConstraintModuli{m.get<double>("volume_modulus"), m.get<double>("area_modulus")}));
+  corrected_volume_.push_back(m.get<std::string>("volume_correction") == "normal_shift"
+                                  ? std::optional<double>(volume(mesh, initial))
+                                  : std::nullopt);
   meshes_.push_back(std::move(mesh));
   references_.push_back(std::move(reference));
   initial_.push_back(std::move(initial));
@@ -281,6 +286,7 @@ void Simulation::pack_membranes() {
   references_.clear();
   initial_.clear();
   membranes_.clear();
+  corrected_volume_.clear();
   for (const auto& place : packing.placements()) {
     Mesh mesh = tmpl;
     std::vector<Vec3> X, R;
@@ -395,6 +401,16 @@ StepRecord Simulation::advance(const std::function<void(const std::string&)>& lo
     r.stats = acc.stats;
     r.dt = acc.dt;
     r.rejected = acc.rejected;
+    for (std::size_t m = 0; m < corrected_volume_.size(); ++m) {
+      if (!corrected_volume_[m]) continue;
+      auto X = op_->membrane_positions(m);
+      try {
+        normal_shift(meshes_[m], X, *corrected_volume_[m]);
+      } catch (const SimulationError& e) {
+        throw SimulationError(membrane_name(m) + " " + e.what());
+      }
+      op_->correct_positions(m, X);
+    }
   } catch (const SimulationError& e) {
     throw SimulationError(where.str() + e.what());
   }

@@ -3,6 +3,7 @@
 // configuration (RunSchema), advanced step by step. Output is not its business: the Runner schedules callbacks
 // (diagnostics, ParaView frames, checkpoints, progress) around advance().
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -34,7 +35,8 @@ class Simulation {
   /// (a membrane outside the box or too close to a wall, two membranes overlapping, bad meshes, ...).
   explicit Simulation(const io::Config& config);
 
-  /// Advances one accepted step (with step halving on failed solves, reported through `log`). Throws
+  /// Advances one accepted step (with step halving on failed solves, reported through `log`), then corrects the
+  /// volume of the membranes with volume_correction = "normal_shift" (VolumeCorrection.hpp). Throws
   /// SimulationError naming step, time, membrane and quantity when the run becomes unstable.
   /// `stop_requested` is asked after each rejected attempt (StopRequested is thrown when it returns true).
   StepRecord advance(const std::function<void(const std::string&)>& log,
@@ -78,6 +80,8 @@ class Simulation {
   std::vector<Mesh> meshes_;
   std::vector<std::vector<Vec3>> references_, initial_;
   std::vector<std::unique_ptr<ElasticMembrane>> membranes_;
+  /// The initial volume of each membrane whose volume is restored after every step (volume_correction).
+  std::vector<std::optional<double>> corrected_volume_;
   std::unique_ptr<ImmersedBoundaryOperator> op_;
   std::unique_ptr<MembraneIntegrator> integrator_;
   AdaptiveStepper stepper_;
