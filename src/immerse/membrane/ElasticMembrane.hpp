@@ -71,6 +71,7 @@ class ElasticMembrane {
   std::size_t num_nodes() const { return reference_.size(); }
   std::size_t num_elements() const { return elements_.size(); }
   ForceMethod method() const { return method_; }
+  const MaterialLaw& law() const { return law_; }
   /// Bytes held by this object (reference data, incidence) plus the workspace compute_force keeps per calling
   /// thread.
   std::size_t memory_bytes() const;
