@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <sstream>
 
 #include "immerse/core/Error.hpp"
 #include "immerse/core/Parallel.hpp"
@@ -17,11 +18,17 @@ double small_strain_area_modulus(const MaterialLaw& law) {
 
 ContactForce::ContactForce(const Grid& grid, const ContactSettings& settings, const std::vector<std::size_t>& offsets,
                            std::vector<double> moduli)
-    : grid_(grid), settings_(settings), eps_d_(settings.strength * settings.range), moduli_(std::move(moduli)) {
+    : grid_(grid),
+      settings_(settings),
+      eps_d_(settings.strength * settings.range),
+      moduli_(std::move(moduli)),
+      offsets_(offsets) {
   for (int k = 0; k < 3; ++k)
-    if (grid_.periodic(k))
-      require(settings_.range < 0.5 * grid_.length(k), "contact.range", settings_.range,
-              "below half the periodic box length " + std::to_string(grid_.length(k)) + " m");
+    if (grid_.periodic(k)) {
+      std::ostringstream half;
+      half << "below half the periodic box length (" << 0.5 * grid_.length(k) << " m)";
+      require(settings_.range < 0.5 * grid_.length(k), "contact.range", settings_.range, half.str());
+    }
   for (std::size_t m = 0; m + 1 < offsets.size(); ++m) membrane_of_.insert(membrane_of_.end(), offsets[m + 1] - offsets[m], m);
 }
 
@@ -81,9 +88,15 @@ void ContactForce::for_each_neighbour(std::span<const Vec3> X, std::size_t i, F&
     for (int y = 0; y < count[1]; ++y)
       for (int x = 0; x < count[0]; ++x) {
         const auto nb = static_cast<std::size_t>((near[2][z] * nb_[1] + near[1][y]) * nb_[0] + near[0][x]);
-        for (std::size_t s = start_[nb]; s < start_[nb + 1]; ++s) {
-          const std::size_t j = sorted_[s];
-          if (membrane_of_[j] == membrane_of_[i]) continue;
+        const auto first = sorted_.begin() + static_cast<std::ptrdiff_t>(start_[nb]),
+                   last = sorted_.begin() + static_cast<std::ptrdiff_t>(start_[nb + 1]);
+        // A bin lists its nodes in ascending order, so node i's own membrane is one run in it: skipped at once.
+        const std::size_t a = membrane_of_[i];
+        const auto own = std::lower_bound(first, last, offsets_[a]), after = std::lower_bound(own, last, offsets_[a + 1]);
+        for (auto s = first; s != last; ++s) {
+          if (s == own) s = after;
+          if (s == last) break;
+          const std::size_t j = *s;
           const Vec3 dx = minimum_image(grid_, X[i], X[j]);
           const double r = norm(dx);
           if (r < d) f(j, dx, r);
@@ -92,7 +105,8 @@ void ContactForce::for_each_neighbour(std::span<const Vec3> X, std::size_t i, F&
 }
 
 void ContactForce::compute(std::span<const Vec3> X, std::span<Vec3> F) {
-  bin(X);
+  const bool pairs = offsets_.size() > 2;  // with one membrane only the walls act
+  if (pairs) bin(X);
   const double d = settings_.range;
   const long n = static_cast<long>(X.size());
 #pragma omp parallel for schedule(static) if (n >= kMinNodesForThreads)
@@ -100,10 +114,11 @@ void ContactForce::compute(std::span<const Vec3> X, std::span<Vec3> F) {
     const auto i = static_cast<std::size_t>(l);
     const std::size_t a = membrane_of_[i];
     Vec3 f{};
-    for_each_neighbour(X, i, [&](std::size_t j, const Vec3& dx, double r) {
-      // r > 0: two coincident nodes have no direction to push along.
-      if (r > 0) f += (scale(a, membrane_of_[j]) * pair_force_shape(r, d) / r) * dx;
-    });
+    if (pairs)
+      for_each_neighbour(X, i, [&](std::size_t j, const Vec3& dx, double r) {
+        // r > 0: two coincident nodes have no direction to push along.
+        if (r > 0) f += (scale(a, membrane_of_[j]) * pair_force_shape(r, d) / r) * dx;
+      });
     if (settings_.walls)
       for (int k = 0; k < 3; ++k) {
         if (grid_.periodic(k)) continue;

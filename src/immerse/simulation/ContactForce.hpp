@@ -27,6 +27,7 @@
 // wall every force is exactly zero, and the run is bitwise that without contact.
 // Verified by tests/test_simulation_contact.cpp (ContactForce.*: gradient, support, third law, walls, neighbour
 // search against brute force; ContactRun.*: two capsules kept apart in shear, an isolated capsule unchanged).
+#include <array>
 #include <cstddef>
 #include <span>
 #include <vector>
@@ -83,6 +84,7 @@ class ContactForce {
   ContactSettings settings_;
   double eps_d_;
   std::vector<double> moduli_;
+  std::vector<std::size_t> offsets_;      ///< first node of each membrane, and the node count
   std::vector<std::size_t> membrane_of_;  ///< membrane of each node
   std::array<long, 3> nb_{};              ///< bins along each axis
   std::array<double, 3> size_{};          ///< bin size along each axis (>= d)
