@@ -149,7 +149,7 @@ TEST_F(RunOutputTest, EndsWithTheProfileAndAFullPrecisionSummary) {
   const std::string log = log_.str();
   const auto profile = log.find("stepping took ");
   ASSERT_NE(profile, std::string::npos) << log;
-  for (const char* part : {"membrane forces", "spreading", "fluid", "interpolation", "the rest"})
+  for (const char* part : {"membrane forces", "contact", "spreading", "fluid", "interpolation", "the rest"})
     EXPECT_NE(log.find(part, profile), std::string::npos) << part;
   const std::string key = "Taylor deformation D_xz = ";
   const auto at = log.find(key, profile);

@@ -63,7 +63,8 @@ TEST_P(PetscOptionsTest, LogViewListsTheImmerseEvents) {
   ASSERT_EQ(r.status, 0) << r.err;
   EXPECT_NE(r.out.find("PETSc Performance Summary"), std::string::npos) << r.out;
   for (const char* event :
-       {"MembraneForces ", "Spreading ", "FluidStep ", "Interpolation ", "ImplicitResidual ", "SNESSolve "})
+       {"MembraneForces ", "ContactForces ", "Spreading ", "FluidStep ", "Interpolation ", "ImplicitResidual ",
+        "SNESSolve "})
     EXPECT_TRUE(has_line_starting(r.out, event)) << event << " missing from\n" << r.out;
 }
 

@@ -78,6 +78,7 @@ class ElasticMembrane {
   ForceMethod method() const { return method_; }
   /// The global volume and area constraints, when a modulus is > 0.
   const std::optional<VolumeAreaConstraint>& constraint() const { return constraint_; }
+  const MaterialLaw& law() const { return law_; }
   /// Bytes held by this object (reference data, incidence) plus the workspace compute_force keeps per calling
   /// thread.
   std::size_t memory_bytes() const;

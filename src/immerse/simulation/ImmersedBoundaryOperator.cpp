@@ -63,7 +63,8 @@ void blend(const Grid& g, double theta, const FaceField& a, const FaceField& b, 
 
 ImmersedBoundaryOperator::ImmersedBoundaryOperator(NavierStokesSolver& fluid, IBCoupler& coupler,
                                                    std::vector<const ElasticMembrane*> membranes,
-                                                   std::vector<std::vector<Vec3>> X0, FluidState fluid_state)
+                                                   std::vector<std::vector<Vec3>> X0, FluidState fluid_state,
+                                                   const ContactSettings& contact)
     : fluid_(fluid),
       coupler_(coupler),
       membranes_(std::move(membranes)),
@@ -84,6 +85,12 @@ ImmersedBoundaryOperator::ImmersedBoundaryOperator(NavierStokesSolver& fluid, IB
   F_.resize(X_.size());
   U_.resize(X_.size());
   applied_.assign(X_.size(), Vec3{});
+  if (contact.range > 0) {
+    std::vector<double> moduli;
+    for (const auto* m : membranes_) moduli.push_back(small_strain_area_modulus(m->law()));
+    contact_.emplace(fluid_.grid(), contact, offset_, std::move(moduli));
+    contact_F_.resize(X_.size());
+  }
   membrane_force_density(X_, force_start_);
   coupler_.interpolate_velocity(committed_.u, X_, U_);
 }
@@ -131,6 +138,14 @@ void ImmersedBoundaryOperator::membrane_force_density(std::span<const Vec3> X, F
   });
   for (const auto& e : error)
     if (e) std::rethrow_exception(e);
+  // After the membranes, which have checked that every node is finite and inside the box.
+  if (contact_)
+    timed(timings_.contact, Phase::Contact, [&] {
+      contact_->compute(X, contact_F_);
+      const long n = static_cast<long>(F_.size());
+#pragma omp parallel for schedule(static) if (n >= kMinNodesForThreads)
+      for (long i = 0; i < n; ++i) F_[static_cast<std::size_t>(i)] += contact_F_[static_cast<std::size_t>(i)];
+    });
   timed(timings_.spread, Phase::Spreading, [&] { coupler_.spread_force(X, F_, f); });
 }
 

@@ -2,6 +2,7 @@
 // The coupled fluid-membrane step as the integrators see it (timestep/CoupledOperator.hpp): the algorithm of §3.
 //
 //   f(X)      membrane forces at the nodes           ElasticMembrane::compute_force  (§2.3, eq. 42 or -dE/dX)
+//             plus the contact forces                 ContactForce::compute (membrane-membrane, membrane-wall)
 //   S(X) f    spread to the MAC faces                 IBCoupler::spread_force          (eq. 6)
 //   u^{n+1}   one projection step driven by F^{n+1/2}  NavierStokesSolver::prepare, step (eqs. 9-13)
 //   J(X) u    interpolated back to the nodes          IBCoupler::interpolate_velocity  (eq. 14)
@@ -14,6 +15,7 @@
 // dt, and shared by all the trials with that dt until commit().
 // All membranes' nodes are concatenated in one array; errors name the membrane and its local node or element.
 #include <algorithm>
+#include <optional>
 #include <span>
 #include <vector>
 
@@ -21,6 +23,7 @@
 #include "immerse/coupling/IBCoupler.hpp"
 #include "immerse/fluid/NavierStokesSolver.hpp"
 #include "immerse/membrane/ElasticMembrane.hpp"
+#include "immerse/simulation/ContactForce.hpp"
 #include "immerse/simulation/StepTimings.hpp"
 #include "immerse/timestep/CoupledOperator.hpp"
 
@@ -28,10 +31,11 @@ namespace immerse {
 
 class ImmersedBoundaryOperator final : public CoupledOperator {
  public:
-  /// `membranes` and their initial positions X0 (one array per membrane); the fluid starts from `fluid_state`.
+  /// `membranes` and their initial positions X0 (one array per membrane); the fluid starts from `fluid_state`;
+  /// the membranes repel each other and the walls by `contact` (off by default).
   ImmersedBoundaryOperator(NavierStokesSolver& fluid, IBCoupler& coupler,
                            std::vector<const ElasticMembrane*> membranes, std::vector<std::vector<Vec3>> X0,
-                           FluidState fluid_state);
+                           FluidState fluid_state, const ContactSettings& contact = {});
 
   std::size_t size() const override { return 3 * X_.size(); }
   std::span<const double> positions() const override { return flat(X_); }
@@ -78,7 +82,7 @@ class ImmersedBoundaryOperator final : public CoupledOperator {
   }
   /// F_ for membrane m at the all-membrane positions X: its elastic force plus the applied force.
   void nodal_force(std::size_t m, std::span<const Vec3> X);
-  /// f = S(X) f(X) for all membranes.
+  /// f = S(X) f(X) for all membranes, the contact forces included.
   void membrane_force_density(std::span<const Vec3> X, FaceField& f);
   /// The fluid step of a trial: trial_ = the step from committed_ driven by F^{n+1/2} of (Xf, theta).
   /// Returns the seconds spent on work that not every evaluation does (the start force, the fluid preparation),
@@ -109,6 +113,8 @@ class ImmersedBoundaryOperator final : public CoupledOperator {
   bool trial_U_valid_ = false;
   std::vector<Vec3> F_;                                 ///< nodal forces, all membranes
   std::vector<Vec3> applied_;                           ///< external nodal forces, all membranes
+  std::optional<ContactForce> contact_;                 ///< when its range is positive
+  std::vector<Vec3> contact_F_;                         ///< contact forces, all membranes
   std::vector<std::vector<Vec3>> Xm_, Fm_;              ///< per-membrane scratch for compute_force
   std::size_t solves_ = 0;
   StepTimings timings_;

@@ -128,6 +128,16 @@ ConfigSchema run_schema() {
   s.add_string("coupling.kernel", "roma3", {"roma3", "peskin4"},
                "discrete delta: Roma-Peskin-Berger 3-point of eq. (8), or Peskin's 4-point");
 
+  s.add_double("contact.range", 0.0, Range::non_negative(),
+               "range d of the repulsion between membranes and from the walls (m; docs/contact.md): nodes of two "
+               "membranes closer than d, or a node closer than d to a wall, push apart with a force rising from zero "
+               "at d; when not given, the grid spacing h (derived); 0 switches contact off");
+  s.add_double("contact.strength", 1.0, Range::positive(),
+               "contact force scale eps (dimensionless): the largest force of one pair of nodes is eps K_s d, with "
+               "K_s the small-strain area modulus of the membranes (N/m; neo-Hookean E_s, Yeoh 6 C10, Skalak "
+               "C11/2 + C21)");
+  s.add_bool("contact.walls", true, "repel the nodes from the no-slip walls as well (contact.range > 0)");
+
   s.add_string("time.scheme", "jfnk", integrator_names(),
                "membrane update: jfnk (§2.4.3), lbfgs, bfgs (eq. 35, small meshes), euler (eq. 28), rk2, anderson "
                "(Anderson acceleration of the implicit update: fewer fluid solves than jfnk on soft cells, §4.4; "

@@ -256,11 +256,19 @@ void check_membrane_keys(const io::Config& config) {
   }
 }
 
+// Any kind: contact within one grid spacing unless contact.range is given.
+io::Config derive_contact(io::Config config) {
+  if (!config.given("contact.range"))
+    config.derive("contact.range", num(config.get<double>("domain.Lx") / config.get<int>("grid.nx")),
+                  "the grid spacing h = domain.Lx / grid.nx (contact.range not given)");
+  return config;
+}
+
 io::Config derive(const io::Config& config) {
   const std::string kind = config.get<std::string>("scenario.kind");
-  if (kind == "rbc_stretch" || kind == "rbc_channel") return derive_centres(derive_cells(config, kind));
-  if (is_shear(kind)) return derive_centres(derive_shear(config, kind));
-  return derive_centres(config);
+  if (kind == "rbc_stretch" || kind == "rbc_channel") return derive_contact(derive_centres(derive_cells(config, kind)));
+  if (is_shear(kind)) return derive_contact(derive_centres(derive_shear(config, kind)));
+  return derive_contact(derive_centres(config));
 }
 
 }  // namespace

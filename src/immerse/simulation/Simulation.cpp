@@ -52,6 +52,10 @@ FluidParams make_fluid(const io::Config& c) {
   return p;
 }
 
+ContactSettings make_contact(const io::Config& c) {
+  return {c.get<double>("contact.range"), c.get<double>("contact.strength"), c.get<bool>("contact.walls")};
+}
+
 SolverSettings make_settings(const io::Config& c) {
   SolverSettings s;
   s.theta = c.get<double>("time.theta");
@@ -149,7 +153,8 @@ Simulation::Simulation(const io::Config& config)
   check_geometry();
   std::vector<const ElasticMembrane*> ms;
   for (auto& m : membranes_) ms.push_back(m.get());
-  op_ = std::make_unique<ImmersedBoundaryOperator>(fluid_, coupler_, ms, initial_, initial_fluid_state());
+  op_ = std::make_unique<ImmersedBoundaryOperator>(fluid_, coupler_, ms, initial_, initial_fluid_state(),
+                                                   make_contact(config));
   op_->set_thread_governor(threads_);
   integrator_ = make_integrator(config.get<std::string>("time.scheme"), make_settings(config));
   if (integrator_->name() == "bfgs" && op_->size() > DenseBfgs::max_unknowns)
@@ -603,7 +608,7 @@ void Simulation::restore(const io::Checkpoint& ck) {
   }
   std::vector<const ElasticMembrane*> ms;
   for (auto& m : membranes_) ms.push_back(m.get());
-  op_ = std::make_unique<ImmersedBoundaryOperator>(fluid_, coupler_, ms, X, std::move(f));
+  op_ = std::make_unique<ImmersedBoundaryOperator>(fluid_, coupler_, ms, X, std::move(f), make_contact(config_));
   integrator_->set_history(prev_X, prev_dt, guess_errors);
   stepper_.set_state(dt, static_cast<int>(successes));
   step_ = step;

@@ -7,6 +7,7 @@ namespace immerse {
 
 std::string StepTimings::profile(double wall_seconds, long steps) const {
   const std::pair<const char*, double> parts[] = {{"membrane forces", force},
+                                                  {"contact", contact},
                                                   {"spreading", spread},
                                                   {"fluid", fluid},
                                                   {"interpolation", interpolate},
@@ -15,7 +16,7 @@ std::string StepTimings::profile(double wall_seconds, long steps) const {
   for (const auto& [name, seconds] : parts) {
     char buf[96];
     std::snprintf(buf, sizeof buf, " %s %.1f (%.0f %%)%s", name, 1e3 * seconds / double(steps),
-                  100 * seconds / wall_seconds, name == parts[4].first ? "" : ",");
+                  100 * seconds / wall_seconds, name == parts[5].first ? "" : ",");
     s += buf;
   }
   return s;

@@ -8,14 +8,16 @@ namespace immerse {
 
 struct StepTimings {
   double force = 0;        ///< membrane forces f(X) of all membranes (§2.3), seconds
+  double contact = 0;      ///< contact forces between membranes and with the walls (ContactForce)
   double spread = 0;       ///< S(X) f (eq. 6)
   double fluid = 0;        ///< the fluid step (eqs. 9-13) with its force F^{n+1/2}
   double interpolate = 0;  ///< J(X) u (eq. 14)
 
-  double total() const { return force + spread + fluid + interpolate; }
+  double total() const { return force + contact + spread + fluid + interpolate; }
   /// The time spent between two readings `earlier` and *this of the same operator.
   StepTimings since(const StepTimings& earlier) const {
-    return {force - earlier.force, spread - earlier.spread, fluid - earlier.fluid, interpolate - earlier.interpolate};
+    return {force - earlier.force, contact - earlier.contact, spread - earlier.spread, fluid - earlier.fluid,
+            interpolate - earlier.interpolate};
   }
   /// One line: each part (and the rest of `wall_seconds`, the wall time of `steps` steps) in ms per step and in
   /// per cent of the wall time.

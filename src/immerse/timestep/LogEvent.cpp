@@ -5,8 +5,8 @@
 namespace immerse {
 namespace {
 
-constexpr std::array<const char*, 5> kNames{"MembraneForces", "Spreading", "FluidStep", "Interpolation",
-                                            "ImplicitResidual"};
+constexpr std::array<const char*, 6> kNames{"MembraneForces", "ContactForces", "Spreading", "FluidStep",
+                                            "Interpolation", "ImplicitResidual"};
 
 // Registered at the first event logged: logging is on only between PetscInitialize and PetscFinalize, and a process
 // initializes PETSc once (PetscSession).

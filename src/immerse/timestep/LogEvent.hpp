@@ -8,6 +8,7 @@ namespace immerse {
 
 enum class Phase {
   MembraneForces,    ///< "MembraneForces": f(X) of all membranes (§2.3)
+  Contact,           ///< "ContactForces": the contact forces (ContactForce)
   Spreading,         ///< "Spreading": S(X) f (eq. 6)
   FluidStep,         ///< "FluidStep": the fluid step (eqs. 9-13)
   Interpolation,     ///< "Interpolation": J(X) u (eq. 14)
