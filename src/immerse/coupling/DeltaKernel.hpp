@@ -1,6 +1,8 @@
 #pragma once
 // A discrete delta kernel chosen at run time ("roma3" or "peskin4"), and the 3D delta function
 // D_h(x) = φ(x/h) φ(y/h) φ(z/h) / h³ of paper eq. (7).
+// Verified by: the study delta_moments and the tests DeltaKernel.* (selection by name, eq. 7 as the scaled
+// tensor product).
 #include <string>
 #include <variant>
 

@@ -2,6 +2,7 @@
 // Checks of membrane node positions against the fluid domain, used before spreading (eq. 6)
 // and interpolation (eq. 14). The arrays are the concatenated nodes of all membranes; errors
 // name the index in that array, and the caller adds membrane, step and time.
+// Verified by the tests NodeDiagnostics.MinWallDistance and IBCoupler.NodesBeyondAWallOrNonFiniteAreNamed.
 #include <span>
 
 #include "immerse/core/Vec3.hpp"

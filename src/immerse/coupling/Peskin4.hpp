@@ -1,5 +1,6 @@
 #pragma once
 // Peskin's 4-point discrete delta kernel (formula in DeltaKernel_K.hpp).
+// Verified by: the study delta_moments (peskin4) and the tests DeltaKernel.*.
 #include "immerse/coupling/DeltaKernel_K.hpp"
 
 namespace immerse {

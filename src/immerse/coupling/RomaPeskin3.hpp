@@ -1,5 +1,6 @@
 #pragma once
 // Roma–Peskin–Berger 3-point discrete delta kernel, paper eq. (8) (the default kernel).
+// Verified by: the study delta_moments (roma3) and the tests DeltaKernel.*.
 #include "immerse/coupling/DeltaKernel_K.hpp"
 
 namespace immerse {

@@ -4,6 +4,7 @@
 //
 // Unknowns of velocity component d: every face of its array, except on a wall axis d the two wall faces
 // (index 0 and n), which hold the prescribed normal wall velocity.
+// Verified by the tests MacOperators.* (the kernels over its unknowns and interior ranges).
 #include <algorithm>
 #include <array>
 

@@ -16,6 +16,8 @@
 // or WrappedRows on periodic boundary rows; no branch), valid wherever every value it reads is a stored one,
 // i.e. away from the wall layers (MacGeom::interior_begin/end). Both forms do the same floating-point operations
 // in the same order, so they give bitwise the same result where both apply.
+// Verified by: the tests MacOperators.* (D = -G*, symmetric Laplacian, row kernels bitwise the generic ones on all 8
+// periodic/wall combinations) and the study fluid_divergence (D u after the projection, ≤ 1e-12).
 #include <array>
 #include <cstddef>
 

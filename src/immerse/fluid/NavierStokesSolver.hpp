@@ -31,6 +31,8 @@
 // step are fluid steps from the same state with the same Δt under different forces: they share one prepare().
 // Both paths evaluate the same pointwise functions, the sums of u^n + (Δt/ρ)(−ρ A − G p + (μ/2) ∇_h² u^n + F +
 // f_body) taken left to right, so the split step is bitwise the one-pass one.
+// Verified by: the studies fluid_divergence, taylor_green, abc_flow, couette, duct_poiseuille, closed_box_mms and the
+// tests NavierStokesSolver.*, CompareRuns.TimeStepErrorInTheStokesRegimeIsSecondOrderWithTheExtrapolatedPressure.
 #include <array>
 #include <cstdint>
 #include <memory>

@@ -5,6 +5,8 @@
 // and is independent of the periodic coordinates, so u.grad_h u = 0, the pressure is uniform and u is an exact
 // steady state of the discrete Navier-Stokes step (one fast-transform solve per component). In a rectangular duct
 // it converges at second order to the series solution (study duct_poiseuille).
+// Verified by the tests PoiseuilleFlow.* (a steady state of the discrete step, second order to the series, input
+// checks) and RbcChannel.ThirtyTwoCellsInAPoiseuilleDuctWithTheirDiagnostics (the channel starts from it).
 #include "immerse/fluid/FluidParams.hpp"
 #include "immerse/grid/FaceField.hpp"
 #include "immerse/grid/Grid.hpp"

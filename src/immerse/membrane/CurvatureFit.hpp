@@ -19,6 +19,8 @@
 // A degree-4 fit gives second derivatives to O(h^3) and first ones to O(h^4) on a smooth surface. The result
 // is a linear function of the positions followed by frame-indifferent algebra, so it is exactly equivariant
 // under rigid motions of X (to round-off) and independent of the thread count.
+// Verified by: the tests MembraneForce.CurvatureFit* (normal and mean curvature on an ellipsoid converge, kappa
+// tangent; a degenerate neighbourhood refused) and the study membrane_bending (linearized load of a Y_lm sphere).
 #include <cstddef>
 #include <vector>
 

@@ -17,6 +17,8 @@
 // See docs/membrane-bending.md for the derivations, the lumping rule and the two deviations from the paper
 // (element-node tensions, not deformation gradients, are averaged at nodes; nodal curvature by a local fit
 // instead of averaging the element-wise (40), so that the nodal bending load converges).
+// Verified by: the studies membrane_rigid_motion, membrane_inflation, membrane_energy_gradient,
+// membrane_force_agreement, membrane_momentum and membrane_bending, and the tests MembraneForce.*.
 #include <cstddef>
 #include <optional>
 #include <vector>

@@ -3,6 +3,7 @@
 // tension law (18): tau = e^{-A1} (dW/dA1 P + dW/dA2 B).
 //   A1 = ln(lambda1 lambda2)                      (19)  area dilatation
 //   A2 = (lambda1^2 + lambda2^2)/2 - 1            (20)
+// Verified by the tests MembraneMaterial.* (dW/dA1 and dW/dA2 of every law against central differences of W).
 namespace immerse {
 
 struct EnergyDensity {

@@ -21,6 +21,8 @@
 // nodes (v0 m01 m20), (m01 v1 m12), (m20 m12 v2), (m01 m12 m20); the curved area of each sub-triangle goes
 // one third to each of its three nodes. The weights are positive at every node (unlike the integrals of
 // the quadratic shape functions, which vanish at the vertices) and sum to the surface area S.
+// Verified by: the study sphere_geometry (curved unit sphere area and volume at order ≥ 3, ellipsoid volume and
+// axes, red cell volume and area) and the tests Geometry.*.
 #include <array>
 #include <vector>
 

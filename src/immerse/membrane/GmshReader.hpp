@@ -5,6 +5,8 @@
 // element's mid-side node when there is one). Other element types (points, lines, ...) are ignored and so are
 // nodes no triangle uses. The result is checked with validate_closed_mesh (messages name the file and the
 // Gmsh ids) after orient_outward, so a consistently but inward-oriented surface is accepted and flipped.
+// Verified by the tests GmshReader.* (each supported form and each defect),
+// RobustnessCorpus.MeshFilesReadOrAreRefusedWithOneLine and Tutorials.CellFromGmshDeformsLikeTheGeneratedCell.
 #include <istream>
 #include <string>
 

@@ -13,6 +13,8 @@
 // Energy gradient at a quadrature point (ElasticMembrane, energy method):
 //   dA1/da_alpha = a^alpha,  dA2/da_alpha = Gbar^{alpha beta} a_beta = A abar^alpha,
 //   dW/da_alpha = dW/dA1 a^alpha + dW/dA2 Gbar^{alpha beta} a_beta.
+// Verified by: the tests MembraneKinematics.* (eq. 39, planar-stretch invariants and tension, sphere-patch curvature,
+// energy-gradient kernel against finite differences) and the study membrane_energy_gradient.
 #include <array>
 #include <cmath>
 

@@ -9,6 +9,8 @@
 //   one connected surface (a file of two cells is refused, naming the count);
 //   positive enclosed volume (elements counter-clockwise seen from outside).
 // Failures throw a one-line InputError: "mesh <label>: element 17 (gmsh id 123) has zero area".
+// Verified by the tests MeshValidation.* and GmshReader.Rejects* (one defect each), and the study mesh_counts
+// (every generated mesh valid).
 #include <cstddef>
 #include <string>
 #include <vector>

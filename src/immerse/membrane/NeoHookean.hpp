@@ -2,6 +2,8 @@
 // Neo-Hookean thin membrane, eq. (22):  W = (Es/6) (2 A2 + e^{-2 A1} - 1).
 // Small-strain surface shear modulus Gs = Es/3, area modulus Ks = Es. Isotropic stretch lambda:
 // tau = (Es/3) (1 - lambda^-6).
+// Verified by the tests MembraneMaterial.* (derivatives, isotropic tension, small-strain moduli, Laplace peak) and
+// the studies membrane_inflation (tensions against the closed forms) and membrane_energy_gradient.
 #include <cmath>
 
 #include "immerse/core/Error.hpp"

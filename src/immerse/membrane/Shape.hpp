@@ -12,6 +12,8 @@
 //                   is a smooth map that keeps the sphere's nodes well spread over the rim.
 // The stress-free reference configuration and the initial configuration are two node arrays on one
 // connectivity: e.g. reference = map_sphere(Sphere{0.2}, unit), initial = map_sphere(Ellipsoid{...}, unit) (§4.1).
+// Verified by: the tests Shape.* (oblate spheroid volume and inclination, eq. 45, shared connectivity) and the study
+// sphere_geometry (ellipsoid of eq. 43 and red cell of eq. 45: volume, axes, area).
 #include <variant>
 #include <vector>
 

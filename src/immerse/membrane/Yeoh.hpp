@@ -2,6 +2,8 @@
 // Yeoh membrane, eq. (23):  W = C10 I + C30 I^3,  I = 2 A2 + e^{-2 A1} - 1.
 // With C10 = mu0/2, C30 = mu0/30: small-strain shear modulus mu0, area modulus 3 mu0.
 // Isotropic stretch lambda: I = 2 lambda^2 + lambda^-4 - 3, tau = 2 (C10 + 3 C30 I^2) (1 - lambda^-6).
+// Verified by the tests MembraneMaterial.* (derivatives, isotropic tension, small-strain moduli) and
+// CellKinds.YeohConstantsFromMu0OrMu0FromC10, and the studies membrane_inflation and membrane_energy_gradient.
 #include <cmath>
 
 #include "immerse/core/Error.hpp"

@@ -14,6 +14,8 @@
 // of the fluid step that does not depend on the force is prepared once from the committed state for the trials'
 // dt, and shared by all the trials with that dt until commit().
 // All membranes' nodes are concatenated in one array; errors name the membrane and its local node or element.
+// Verified by the tests ImmersedBoundaryOperator.* (thread independence, what trials take over and reuse, failing
+// membrane named) and the studies oscillating_time_order and oscillating_stability, which step through it.
 #include <algorithm>
 #include <optional>
 #include <span>

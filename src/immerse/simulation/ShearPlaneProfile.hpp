@@ -4,6 +4,7 @@
 // centroid). The section is the polygon where the plane cuts the four flat sub-triangles of each curved element.
 // (The inclination is taken from the principal axes instead: the direction of L jumps from node to node as the
 // membrane tank-treads.)
+// Verified by the test Tutorials.CapsuleInYourShearDeformsAsTheSmallDeformationTheory (D_xz within 15 % of 25G/4).
 #include <vector>
 
 #include "immerse/membrane/Mesh.hpp"

@@ -10,6 +10,8 @@
 // transverse = the largest extent along y (perpendicular to the force in the plane of the disc, which lies in x-y).
 // The sweep's own state (which force, since when it waits, the last diameters) goes into the run's checkpoints, so
 // that a sweep restarted from one continues bitwise identically.
+// Verified by the tests RestartSweep.ForceSweepContinuesBitwiseFromAMidSweepCheckpoint and
+// BadInputScenario.StretchPatchesAsWideAsTheCellAreRefused.
 #include <vector>
 
 #include "immerse/io/Checkpoint.hpp"

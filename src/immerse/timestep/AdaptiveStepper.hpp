@@ -3,6 +3,8 @@
 // iteration limit, a non-finite residual, a trial position outside the domain) is rejected, nothing is committed,
 // and it is retried with half the step; after `grow_after` accepted steps the step doubles again, back up to the
 // nominal one. Below the floor dt_min the run stops with a SimulationError. Never silently accepts a failed step.
+// Verified by the tests AdaptiveStepper.* (halves on failure and grows back, nothing committed; stops below the
+// floor).
 #include <functional>
 #include <string>
 

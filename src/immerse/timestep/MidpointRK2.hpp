@@ -10,6 +10,8 @@
 // the same explicit terms E, and since D u^n = 0 its projection takes the same phi: (u^n + u^{n+1})/2 is [37]'s
 // u^{n+1/2} apart from the explicit advection and pressure terms, at half the fluid work. The mean is interpolated
 // once (CoupledOperator::trial_mean_velocity): two interpolations per step, J(X^n) u^n and this one.
+// Verified by the tests Integrators.MidpointRK2IsSecondOrderAndEulerFirst and
+// ImmersedBoundaryOperator.TrialMeanVelocityIsTheMeanOfTheCommittedAndTrialVelocities.
 #include "immerse/timestep/MembraneIntegrator.hpp"
 
 namespace immerse {

@@ -35,6 +35,8 @@
 // PETSC_OPTIONS (the former wins; both win over the settings); an option that no PETSc object of the solver, nor
 // PETSc itself, has used by the end of the first solve that iterates is an InputError (docs/user-guide.md, "PETSc
 // options").
+// Verified by: the studies oscillating_time_order, oscillating_stability, theta_ringing and quasi_newton_agreement,
+// and the tests Integrators.*, PetscOptionsTest.* and PetscOptionsBoth.*.
 #include <petscsnes.h>
 
 #include <exception>

@@ -9,6 +9,8 @@
 // makes the coupled step second order for both X and u (Table 1; docs/theory/conventions.md). theta = 1 is backward Euler
 // (L-stable: no ringing of stiff membrane modes at large dt). g is a pure function of X: the committed state is
 // never changed, so GMRES may evaluate it as often as it needs (each evaluation is one fluid solve).
+// Verified by: the studies oscillating_time_order (theta = 1/2) and theta_ringing (theta = 1/2 rings, theta = 1
+// does not), and the tests Integrators.TrapezoidalJfnkIsSecondOrderForPositionAndVelocity, Integrators.BackwardEuler*.
 #include <span>
 #include <vector>
 
