@@ -4,7 +4,8 @@
 //   mu lap_h u_d = -f_d,   u_d = 0 on the walls,
 // and is independent of the periodic coordinates, so u.grad_h u = 0, the pressure is uniform and u is an exact
 // steady state of the discrete Navier-Stokes step (one fast-transform solve per component). In a rectangular duct
-// it converges at second order to the series solution (study duct_poiseuille).
+// it converges at second order to the series solution (the study duct_poiseuille shows the same of the discrete
+// duct problem solved directly).
 // Verified by the tests PoiseuilleFlow.* (a steady state of the discrete step, second order to the series, input
 // checks) and RbcChannel.ThirtyTwoCellsInAPoiseuilleDuctWithTheirDiagnostics (the channel starts from it).
 #include "immerse/fluid/FluidParams.hpp"
