@@ -18,6 +18,7 @@
 #include <sstream>
 
 #include "immerse/core/Error.hpp"
+#include "immerse/core/MemoryLimits.hpp"
 #include "immerse/io/AtomicFile.hpp"
 #include "immerse/io/CsvWriter.hpp"
 #include "immerse/io/OutputFolder.hpp"
@@ -178,63 +179,6 @@ std::string grid_text(const io::Config& c) {
          std::to_string(c.get<int>("grid.nz"));
 }
 
-std::string gigabytes(double bytes) {
-  std::ostringstream s;
-  s << std::setprecision(3) << std::max(bytes, 0.0) / 1e9 << " GB";
-  return s.str();
-}
-
-struct MemoryLimit {
-  double bytes;
-  std::string what;  // e.g. "this machine's memory (25.3 GB)"
-};
-
-// The smallest memory limit of the cgroup at `dir` (relative to the hierarchy mounted at `root`) and its ancestors,
-// read from `file` (cgroup v2 memory.max, "max" meaning none; v1 memory.limit_in_bytes, huge meaning none).
-std::optional<MemoryLimit> cgroup_memory_limit(const std::string& root, std::string dir, const std::string& file) {
-  std::optional<MemoryLimit> limit;
-  while (true) {
-    std::ifstream in(root + dir + "/" + file);
-    std::string text;
-    if (in >> text && text != "max") {
-      const double bytes = std::strtod(text.c_str(), nullptr);
-      if (bytes > 0 && bytes < 1e18 && (!limit || bytes < limit->bytes))
-        limit = MemoryLimit{bytes, "the cgroup memory limit (" + gigabytes(bytes) + ", " + root + dir + "/" + file + ")"};
-    }
-    if (dir.empty() || dir == "/") break;
-    dir = dir.substr(0, dir.find_last_of('/'));
-  }
-  return limit;
-}
-
-// The memory a run may use: the smallest of the physical memory, the cgroup memory limit (v2 or v1) of this
-// process and what the address-space limit (ulimit -v) leaves beside the address space already mapped.
-std::vector<MemoryLimit> memory_limits() {
-  std::vector<MemoryLimit> limits;
-  if (const double memory = double(sysconf(_SC_PHYS_PAGES)) * double(sysconf(_SC_PAGESIZE)); memory > 0)
-    limits.push_back({memory, "this machine's memory (" + gigabytes(memory) + ")"});
-  if (rlimit as{}; getrlimit(RLIMIT_AS, &as) == 0 && as.rlim_cur != RLIM_INFINITY) {
-    double mapped_pages = 0;
-    std::ifstream("/proc/self/statm") >> mapped_pages;
-    const double left = double(as.rlim_cur) - mapped_pages * double(sysconf(_SC_PAGESIZE));
-    limits.push_back({left, "the " + gigabytes(left) + " that the address-space limit (ulimit -v = " +
-                                gigabytes(double(as.rlim_cur)) + ") leaves this process"});
-  }
-  // /proc/self/cgroup: "0::/path" (v2) or "N:...memory...:/path" (v1).
-  std::ifstream in("/proc/self/cgroup");
-  for (std::string line; std::getline(in, line);) {
-    const auto a = line.find(':'), b = line.find(':', a + 1);
-    if (a == std::string::npos || b == std::string::npos) continue;
-    const std::string controllers = line.substr(a + 1, b - a - 1), path = line.substr(b + 1);
-    std::optional<MemoryLimit> limit;
-    if (controllers.empty())
-      limit = cgroup_memory_limit("/sys/fs/cgroup", path, "memory.max");
-    else if (("," + controllers + ",").find(",memory,") != std::string::npos)
-      limit = cgroup_memory_limit("/sys/fs/cgroup/memory", path, "memory.limit_in_bytes");
-    if (limit) limits.push_back(*limit);
-  }
-  return limits;
-}
 
 // A grid beyond the memory the run may use is refused before anything is allocated (the operating system would
 // otherwise grant the memory and kill the run when it is touched). kBytesPerCell is a lower bound: the peak
