@@ -119,75 +119,31 @@ CellPacking::CellPacking(const Grid& grid, const std::vector<Vec3>& shape, doubl
                        " at the start size");
   }
 
-  // 2. Grow and push apart. Nodes are sorted into a periodic grid of bins of size >= c (a cell list). The growth
-  // factor adapts: halved when pushing apart takes many sweeps, doubled (up to kGrowth) when it takes few.
-  std::vector<Vec3> turned;  // rotation[i] * shape, for all copies
-  turned.reserve(N * shape.size());
+  // 2. Grow and push apart; the close node pairs come from the cell list of MembraneClearance. The growth factor
+  // adapts: halved when pushing apart takes many sweeps, doubled (up to kGrowth) when it takes few.
+  std::vector<std::vector<Vec3>> turned(N), X(N);  // rotation[i] * shape, and the copies' nodes at size s
   for (std::size_t i = 0; i < N; ++i)
-    for (const auto& p : shape) turned.push_back(rotation[i] * p);
-  std::array<int, 3> bins{};
-  for (int a = 0; a < 3; ++a) bins[a] = std::max(1, static_cast<int>(std::floor(span[a] / c)));
-  const auto bin_of = [&](const Vec3& x, int a) {
-    const int b = static_cast<int>(std::floor((x[a] - lo[a]) / span[a] * bins[a]));
-    return std::clamp(b, 0, bins[a] - 1);  // nodes past a wall (pushed back below) go to the last bin
-  };
-  const auto index_of = [&](const std::array<int, 3>& b) {
-    return (static_cast<std::size_t>(b[0]) * static_cast<std::size_t>(bins[1]) + static_cast<std::size_t>(b[1])) *
-               static_cast<std::size_t>(bins[2]) + static_cast<std::size_t>(b[2]);
-  };
-  const std::size_t n = shape.size(), nbins = index_of({bins[0] - 1, bins[1] - 1, bins[2] - 1}) + 1;
-  std::vector<Vec3> X(N * n);
-  std::vector<std::size_t> start(nbins + 1), order(N * n), bin(N * n);
+    for (const auto& p : shape) turned[i].push_back(rotation[i] * p);
   const auto wrap = [&](Vec3 x) {
     for (int a = 0; a < 3; ++a)
       if (grid.periodic(a)) x[a] = lo[a] + std::fmod(std::fmod(x[a] - lo[a], span[a]) + span[a], span[a]);
     return x;
   };
+  const std::size_t n = shape.size();
   double growth = kGrowth - 1;
   while (true) {
     bool clear = false;
     int sweeps = 0;
     for (; sweeps < kMaxSweeps && !clear; ++sweeps) {
-      std::fill(start.begin(), start.end(), 0);
-      for (std::size_t i = 0; i < N; ++i)
-        for (std::size_t k = 0; k < n; ++k) {
-          const std::size_t q = i * n + k;
-          X[q] = wrap(centre[i] + s * turned[q]);
-          bin[q] = index_of({bin_of(X[q], 0), bin_of(X[q], 1), bin_of(X[q], 2)});
-          ++start[bin[q] + 1];
-        }
-      for (std::size_t b = 0; b < nbins; ++b) start[b + 1] += start[b];
-      {
-        std::vector<std::size_t> fill(start.begin(), start.end() - 1);
-        for (std::size_t q = 0; q < X.size(); ++q) order[fill[bin[q]]++] = q;
+      for (std::size_t i = 0; i < N; ++i) {
+        X[i].resize(n);
+        for (std::size_t k = 0; k < n; ++k) X[i][k] = wrap(centre[i] + s * turned[i][k]);
       }
       std::map<std::pair<std::size_t, std::size_t>, double> depth;  // deepest node overlap of each pair of copies
-      for (std::size_t q = 0; q < X.size(); ++q) {
-        const std::array<int, 3> b{bin_of(X[q], 0), bin_of(X[q], 1), bin_of(X[q], 2)};
-        for (int dx = -1; dx <= 1; ++dx)
-          for (int dy = -1; dy <= 1; ++dy)
-            for (int dz = -1; dz <= 1; ++dz) {
-              const std::array<int, 3> d{dx, dy, dz};
-              std::array<int, 3> nb{};
-              bool inside = true;
-              for (int a = 0; a < 3; ++a) {
-                nb[a] = b[a] + d[a];
-                if (grid.periodic(a)) nb[a] = (nb[a] % bins[a] + bins[a]) % bins[a];
-                inside = inside && nb[a] >= 0 && nb[a] < bins[a];
-              }
-              if (!inside) continue;
-              const std::size_t nbin = index_of(nb);
-              for (std::size_t o = start[nbin]; o < start[nbin + 1]; ++o) {
-                const std::size_t r = order[o];
-                if (r / n <= q / n) continue;  // each pair of copies once, never a copy with itself
-                const double gap = norm(minimum_image(grid, X[q], X[r]));
-                if (gap < c) {
-                  double& deepest = depth[{q / n, r / n}];
-                  deepest = std::max(deepest, c - gap);
-                }
-              }
-            }
-      }
+      for_each_foreign_pair(grid, X, c, [&](const NodePairGap& g) {
+        double& deepest = depth[{g.membrane_b, g.membrane_a}];
+        deepest = std::max(deepest, c - g.distance);
+      });
       std::vector<Vec3> push(N);
       for (const auto& [pair, d] : depth) {
         Vec3 dir = minimum_image(grid, centre[pair.second], centre[pair.first]);
@@ -202,7 +158,7 @@ CellPacking::CellPacking(const Grid& grid, const std::vector<Vec3>& shape, doubl
         for (int a = 0; a < 3; ++a) {
           if (grid.periodic(a)) continue;
           double low = lo[a] + span[a], high = lo[a];
-          for (std::size_t k = 0; k < n; ++k) low = std::min(low, X[i * n + k][a]), high = std::max(high, X[i * n + k][a]);
+          for (const auto& x : X[i]) low = std::min(low, x[a]), high = std::max(high, x[a]);
           if (low < lo[a] + c) push[i][a] += lo[a] + c - low + 0.01 * c, walls_clear = false;
           if (high > lo[a] + span[a] - c) push[i][a] -= high - (lo[a] + span[a] - c) + 0.01 * c, walls_clear = false;
         }

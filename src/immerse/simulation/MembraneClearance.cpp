@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <array>
+#include <functional>
 #include <cmath>
 #include <numbers>
 #include <tuple>
@@ -15,8 +16,8 @@ Vec3 minimum_image(const Grid& grid, const Vec3& a, const Vec3& b) {
   return d;
 }
 
-std::optional<NodePairGap> closest_foreign_nodes(const Grid& grid, const std::vector<std::vector<Vec3>>& X,
-                                                 double reach) {
+void for_each_foreign_pair(const Grid& grid, const std::vector<std::vector<Vec3>>& X, double reach,
+                           const std::function<void(const NodePairGap&)>& visit) {
   // Bins of size >= reach covering the box (nodes beyond a periodic end are wrapped in).
   std::array<long, 3> nb{};
   std::array<double, 3> size{};
@@ -48,12 +49,6 @@ std::optional<NodePairGap> closest_foreign_nodes(const Grid& grid, const std::ve
   for (std::size_t k = items.size(); k-- > 0;) start[static_cast<std::size_t>(items[k].bin)] = k;
   for (std::size_t b = start.size() - 1; b-- > 0;) start[b] = std::min(start[b], start[b + 1]);
 
-  std::optional<NodePairGap> best;
-  auto better = [&](const NodePairGap& g) {
-    if (!best) return true;
-    return std::tie(g.distance, g.membrane_b, g.node_b, g.membrane_a, g.node_a) <
-           std::tie(best->distance, best->membrane_b, best->node_b, best->membrane_a, best->node_a);
-  };
   for (std::size_t m = 0; m < X.size(); ++m)
     for (std::size_t i = 0; i < X[m].size(); ++i) {
       const auto c = bin_coords(X[m][i]);
@@ -73,11 +68,20 @@ std::optional<NodePairGap> closest_foreign_nodes(const Grid& grid, const std::ve
               if (o.m >= m) continue;  // each pair once, from the higher membrane index
               const double d = norm(minimum_image(grid, X[m][i], X[o.m][o.i]));
               if (d >= reach) continue;
-              const NodePairGap g{m, i, o.m, o.i, d};
-              if (better(g)) best = g;
+              visit(NodePairGap{m, i, o.m, o.i, d});
             }
           }
     }
+}
+
+std::optional<NodePairGap> closest_foreign_nodes(const Grid& grid, const std::vector<std::vector<Vec3>>& X,
+                                                 double reach) {
+  std::optional<NodePairGap> best;
+  for_each_foreign_pair(grid, X, reach, [&](const NodePairGap& g) {
+    if (!best || std::tie(g.distance, g.membrane_b, g.node_b, g.membrane_a, g.node_a) <
+                     std::tie(best->distance, best->membrane_b, best->node_b, best->membrane_a, best->node_a))
+      best = g;
+  });
   return best;
 }
 

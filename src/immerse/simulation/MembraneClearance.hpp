@@ -11,6 +11,7 @@
 // no node are tested for an edge of one passing through the other (signs of tetrahedron volumes).
 // Verified by the tests MembraneClearance.* (hash grid against brute force with periodic images, winding number,
 // self-intersection).
+#include <functional>
 #include <optional>
 #include <utility>
 #include <vector>
@@ -25,6 +26,11 @@ struct NodePairGap {
   std::size_t membrane_a = 0, node_a = 0, membrane_b = 0, node_b = 0;  ///< membrane_a > membrane_b
   double distance = 0;
 };
+
+/// Calls `visit` for every pair of nodes of two different membranes closer than `reach` (once per pair, membrane_a >
+/// membrane_b), found through a cell list of bins of size >= reach.
+void for_each_foreign_pair(const Grid& grid, const std::vector<std::vector<Vec3>>& X, double reach,
+                           const std::function<void(const NodePairGap&)>& visit);
 
 /// The closest pair of nodes of two different membranes among those closer than `reach`; nullopt if there is none.
 /// Ties go to the pair with the lowest membrane and node indices (the result does not depend on binning order).
