@@ -87,9 +87,9 @@ ConfigSchema run_schema() {
                     "rbc_stretch: the stretching forces of the sweep (pN), each run to steady state");
   s.add_double("scenario.patch_um", 2.0, Range::positive(),
                "rbc_stretch: diameter of the two contact patches at the ends of the diameter along x (um)");
-  s.add_double("scenario.steady_tol", 1e-3, Range::open(0, 1),
+  s.add_double("scenario.steady_tol", 1e-4, Range::open(0, 1),
                "rbc_stretch: steady when both diameters change by less than this (relative) over one relaxation time");
-  s.add_double("scenario.max_relaxation_times", 60.0, Range::positive(),
+  s.add_double("scenario.max_relaxation_times", 200.0, Range::positive(),
                "rbc_stretch: give up waiting for a steady state after this many relaxation times per force");
   s.add_double("scenario.k_dt", 0.01, Range::positive(), "shear scenarios: time step in units of 1/k");
   s.add_double("scenario.kt_end", 10.0, Range::positive(), "shear scenarios: end time in units of 1/k");
