@@ -19,6 +19,7 @@ constexpr double kMaxStep = 0.2;           // largest node displacement per rela
 constexpr double kGrowthMax = 0.02;        // largest size factor step (1 + g)
 constexpr double kGrowthMin = 1e-4;        // the copies jam when a growth step this small cannot be relaxed
 constexpr int kMaxIterations = 2000;       // relaxation steps at one size before the size steps back
+constexpr long kMaxTotal = 20000;          // relaxation steps in all before the copies count as jammed
 // FIRE (Bitzek et al. 2006): steps with P > 0 before dt grows; dt factors; mixing α and its decay.
 constexpr int kFireDelay = 5;
 constexpr double kFireGrow = 1.1, kFireShrink = 0.5, kFireAlpha = 0.1, kFireAlphaDecay = 0.99;
@@ -109,7 +110,8 @@ class Relaxation {
     moved_.assign(N_, 0.0);
   }
 
-  double bounding_radius() const { return R_; }
+  /// Relaxation steps taken so far, at all sizes.
+  long steps() const { return steps_; }
 
   /// Every node's largest move when the size changes from s to s_new (the pair list accounts for it).
   void resize(double s, double s_new) {
@@ -123,7 +125,7 @@ class Relaxation {
     const double sqrtI = s * std::sqrt(mean_r2_);  // scalar moment of inertia of a unit mass spread over the nodes
     double dt = kFireDt, alpha = kFireAlpha;
     int positive = 0;
-    for (int iteration = 0; iteration < kMaxIterations; ++iteration) {
+    for (int iteration = 0; iteration < kMaxIterations; ++iteration, ++steps_) {
       positions(s);
       if (stale()) rebuild();
       if (forces(F, G, sqrtI)) return true;
@@ -256,6 +258,7 @@ class Relaxation {
   std::vector<NodePairGap> pairs_;
   std::vector<double> moved_;  // largest node displacement of each copy since the pair list was built
   bool built_ = false;
+  long steps_ = 0;
 };
 
 }  // namespace
@@ -313,7 +316,8 @@ CellPacking::CellPacking(const Grid& grid, const std::vector<Vec3>& shape, doubl
   }
 
   // 2. Grow and relax. A size that does not relax within kMaxIterations steps is stepped back to the last clear size
-  // times 1 + g/2 (the copies keep their places) and the growth step g halves.
+  // times 1 + g/2 (the copies keep their places) and the growth step g halves; the copies are jammed when g falls
+  // below kGrowthMin or when a size fails after kMaxTotal steps in all.
   Relaxation relaxation(grid, shape, c, centre, orientation);
   double growth = std::min(kGrowthMax, kMaxStep * c / R), s_clear = s;  // a growth step moves nodes <= kMaxStep c
   while (true) {
@@ -324,7 +328,7 @@ CellPacking::CellPacking(const Grid& grid, const std::vector<Vec3>& shape, doubl
       next = std::min(1.0, s * (1 + growth));
     } else {
       growth /= 2;
-      if (growth < kGrowthMin)
+      if (growth < kGrowthMin || relaxation.steps() > kMaxTotal)
         throw InputError(std::string(key) + ": the copies jam at " + number(100 * s_clear) +
                          " % of their size (volume fraction reached: " + number(s_clear * s_clear * s_clear) +
                          " of the one asked for); ask for fewer cells, a larger box or a smaller packing.clearance");
