@@ -18,7 +18,8 @@
 //      so no copy passes through another. The relaxation stops when no gap is below c;
 //   3. the copies grow by up to 2 % (no node moving more than 0.2 c) and relax again, until full size. A size that
 //      does not relax within 2,000 steps is stepped back towards the last clear one and the growth step halved;
-//      when it falls below 1e-4 the copies are jammed and the request is refused.
+//      when it falls below 1e-4, or a size fails after 20,000 steps in all, the copies are jammed and the request
+//      is refused.
 //
 // Close node pairs come from a list of the pairs within (1.05 + 0.6) c, built by MembraneClearance's cell list and
 // rebuilt when the two copies that moved most since have moved 0.6 c together (a Verlet list). Everything is summed
