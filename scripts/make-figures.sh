@@ -10,6 +10,8 @@
 #   bending_shear_quick at G = 0.2, kappa_B_hat = 0, 0.04, 0.1, 0.15 to k t = 4       (§4.2.3, Fig. 11b)
 #   rbc_channel_quick, 32 cells to t = 0.05 s                                         (§4.4, Fig. 15)
 #   rbc_stretch_quick at mu0 = 7.3, 10 uN/m, forces 0, 38.9, 110, 194 pN, looser steady state  (§4.3, Figs. 13-14)
+# and the paper-size refinement study oblate_shear, b/a = 0.9, G = 0.2 at 64^3 (4,098 and 10,242 nodes) and 96^3
+# (10,242 nodes) (§4.2.2, Fig. 10; 10-30 minutes each on one core; FIG10=0 leaves it out)
 # into out/figures/, then plots with Debian's matplotlib (/usr/bin/python3). Each plot script prints its key numbers.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -81,6 +83,15 @@ for kappa in 0 0.04 0.1 0.15; do
   start bending_shear_quick "$runs/bending_G0.2_kB$kappa" --set scenario.G=0.2 --set scenario.kappa_B_hat=$kappa \
     --set scenario.kt_end=4
 done
+# Fig. 10: the paper's refinement study at its sizes, diagnostics only.
+if [[ ${FIG10:-1} == 1 ]]; then
+  for case in 64:octahedral 64:icosahedral 96:icosahedral; do
+    IFS=: read -r n family <<< "$case"
+    start oblate_shear "$runs/refine_${n}_$family" --set scenario.G=0.2 --set grid.nx=$n --set grid.ny=$n \
+      --set grid.nz=$n --set "membrane[0].mesh.family=\"$family\"" --set "membrane[0].mesh.level=4" \
+      --set output.fields_every=0
+  done
+fi
 # Fig. 15: the 32 cells of the quick channel at t = 0 and t = 0.05 s (the longest of these runs).
 start rbc_channel_quick "$runs/channel" --set output.fluid_fields=false
 wait
@@ -93,6 +104,10 @@ $python scripts/plot_semi_axes.py "$runs/osc_mu0.1" -o "$figs/fig5_semi_axes_mu0
 $python scripts/plot_taylor.py "$runs"/shear_G0.0125 "$runs"/shear_G0.05 "$runs"/shear_G0.1 -o "$figs/fig7_taylor.png"
 $python scripts/plot_taylor.py "$runs"/oblate_ba0.9_G0.1 "$runs"/oblate_ba0.9_G0.2 -o "$figs/fig8_oblate_ba0.9.png"
 $python scripts/plot_taylor.py "$runs"/oblate_ba0.5_G0.2 -o "$figs/fig9_oblate_ba0.5.png"
+if [[ ${FIG10:-1} == 1 ]]; then
+  $python scripts/plot_taylor.py "$runs"/refine_64_octahedral "$runs"/refine_64_icosahedral "$runs"/refine_96_icosahedral \
+    --title "Oblate capsule, b/a = 0.9, G = 0.2: grid refinement" -o "$figs/fig10_refinement.png"
+fi
 $python scripts/plot_taylor.py "$runs"/bending_G0.05_kB{0,0.01,0.025,0.0375} -o "$figs/fig11_bending_G0.05.png"
 $python scripts/plot_taylor.py "$runs"/bending_G0.2_kB{0,0.04,0.1,0.15} -o "$figs/fig11b_bending_G0.2.png"
 $python scripts/plot_shapes.py "$runs/osc_euler" --frames 0,3,6,-1 -o "$figs/fig6_explicit_shapes.png"

@@ -97,6 +97,18 @@ def label_of(cfg, run_dir):
     return os.path.basename(os.path.normpath(run_dir))
 
 
+def resolution_of(cfg, membrane=0):
+    """The grid and the node count of membrane `membrane`, e.g. "64³ grid, 10,242 nodes" (generated meshes only)."""
+    g = cfg["grid"]
+    n = (g["nx"], g["ny"], g["nz"])
+    grid = f"{n[0]}³ grid" if n[0] == n[1] == n[2] else f"{n[0]}×{n[1]}×{n[2]} grid"
+    mesh = cfg["membrane"][membrane].get("mesh", {})
+    per_level = {"icosahedral": 10, "octahedral": 4}.get(mesh.get("family"))
+    if per_level is None:
+        return grid
+    return f"{grid}, {per_level * 4 ** (mesh['level'] + 1) + 2:,} nodes"
+
+
 def parse_numbers(option, text):
     """Comma-separated numbers of a command-line option, e.g. --times 0,0.5,1."""
     try:

@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""Figs. 7, 8-9 and 11 of the paper: the Taylor shape parameter D_xz = (L - B)/(L + B) vs k t, for one or several runs.
+"""Figs. 7, 8-10 and 11 of the paper: the Taylor shape parameter D_xz = (L - B)/(L + B) vs k t, for one or several runs.
 
 Usage: /usr/bin/python3 scripts/plot_taylor.py RUN_DIR [RUN_DIR ...] [-o PNG] [--membrane I] [--theta]
                                                [--panel-per-G] [--title TEXT]
@@ -12,6 +12,7 @@ not apply to oblate or bending capsules and the paper draws none there. When the
 line width grows with kappa_B_hat, as in Fig. 11. --panel-per-G draws one panel per value of G (Fig. 11 a, b).
 With --theta a second row of panels shows the inclination theta (for capsule_shear against its small-deformation
 value pi/4 - 97G/16). A run that stopped before scenario.kt_end (e.g. an element inverted) says so in the legend.
+Runs with the same groups (a refinement study, Fig. 10) are told apart by their grid and node count.
 Default PNG: taylor.png in the first RUN_DIR.
 """
 import argparse
@@ -74,6 +75,8 @@ def main():
             theta = pc.membrane_column(diag, "theta", args.membrane)
             color, lw = f"C{i}", width[r["kappa"]]
             label = pc.label_of(r["cfg"], r["dir"])
+            if sum(pc.label_of(m["cfg"], m["dir"]) == label for m in members) > 1:  # a refinement study (Fig. 10)
+                label += f" ({pc.resolution_of(r['cfg'], args.membrane)})"
             sc = r["cfg"]["scenario"]
             if kt[-1] < sc["kt_end"] - 0.5 * sc["k_dt"]:  # the run stopped early (e.g. a mesh element inverted)
                 label += f" (run stopped at k t = {kt[-1]:.3g})"
