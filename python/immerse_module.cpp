@@ -16,11 +16,11 @@
 #include <string>
 #include <vector>
 
+#include "immerse/app/Diagnostics.hpp"
+#include "immerse/app/Scenario.hpp"
 #include "immerse/core/Error.hpp"
 #include "immerse/io/Config.hpp"
-#include "immerse/simulation/Diagnostics.hpp"
 #include "immerse/simulation/RunSchema.hpp"
-#include "immerse/simulation/Scenario.hpp"
 #include "immerse/simulation/Simulation.hpp"
 #include "immerse/timestep/PetscSession.hpp"
 

@@ -19,7 +19,7 @@ class DenseBfgs final : public MembraneIntegrator {
   /// Largest number of unknowns accepted (the n x n matrix must fit comfortably in memory).
   static constexpr std::size_t max_unknowns = 12000;
   explicit DenseBfgs(const SolverSettings& settings);
-  StepStats step(CoupledOperator& op, double dt) override;
+  SolverStats step(CoupledOperator& op, double dt) override;
   std::string name() const override { return "bfgs"; }
 
  private:

@@ -7,7 +7,7 @@
 
 #include "immerse/timestep/CoupledOperator.hpp"
 #include "immerse/timestep/ErrorRecurrence.hpp"
-#include "immerse/timestep/StepStats.hpp"
+#include "immerse/timestep/SolverStats.hpp"
 #include "immerse/timestep/ThetaResidual.hpp"
 
 namespace immerse {
@@ -33,7 +33,7 @@ class MembraneIntegrator {
   virtual ~MembraneIntegrator() = default;
   /// Attempts one step of length dt. On success the operator is committed; on failure nothing is
   /// (stats.converged == false, stats.failure says why).
-  virtual StepStats step(CoupledOperator& op, double dt) = 0;
+  virtual SolverStats step(CoupledOperator& op, double dt) = 0;
   virtual std::string name() const = 0;
   /// Sets the scheme up for `unknowns` unknowns before the first step, so that a run reports solver options PETSc
   /// rejects (InputError) before it writes anything. Optional: step() sets up what it needs.

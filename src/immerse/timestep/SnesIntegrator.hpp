@@ -55,7 +55,7 @@ class SnesIntegrator final : public MembraneIntegrator {
   SnesIntegrator(const SnesIntegrator&) = delete;
   SnesIntegrator& operator=(const SnesIntegrator&) = delete;
 
-  StepStats step(CoupledOperator& op, double dt) override;
+  SolverStats step(CoupledOperator& op, double dt) override;
   std::string name() const override;
   /// Creates the PETSc solver with PETSC_OPTIONS and solver.petsc_options applied; a value PETSc rejects is an
   /// InputError.

@@ -1,4 +1,4 @@
-#include "immerse/simulation/Runner.hpp"
+#include "immerse/app/RunCommand.hpp"
 
 #include <sys/resource.h>
 #include <unistd.h>
@@ -17,6 +17,11 @@
 #include <optional>
 #include <sstream>
 
+#include "immerse/app/Callback.hpp"
+#include "immerse/app/Diagnostics.hpp"
+#include "immerse/app/Scenario.hpp"
+#include "immerse/app/ShearPlaneProfile.hpp"
+#include "immerse/app/StretchSweep.hpp"
 #include "immerse/core/Error.hpp"
 #include "immerse/core/MemoryLimits.hpp"
 #include "immerse/io/AtomicFile.hpp"
@@ -26,13 +31,8 @@
 #include "immerse/io/TomlFormat.hpp"
 #include "immerse/io/XdmfWriter.hpp"
 #include "immerse/membrane/Geometry.hpp"
-#include "immerse/simulation/Callback.hpp"
-#include "immerse/simulation/Diagnostics.hpp"
 #include "immerse/simulation/RunSchema.hpp"
-#include "immerse/simulation/Scenario.hpp"
-#include "immerse/simulation/ShearPlaneProfile.hpp"
 #include "immerse/simulation/Simulation.hpp"
-#include "immerse/simulation/StretchSweep.hpp"
 
 namespace immerse {
 

@@ -1,11 +1,11 @@
-#include "immerse/simulation/Diagnostics.hpp"
+#include "immerse/app/Diagnostics.hpp"
 
 #include <cmath>
 #include <stdexcept>
 
+#include "immerse/app/Scenario.hpp"
+#include "immerse/app/ShearPlaneProfile.hpp"
 #include "immerse/membrane/CellDiameters.hpp"
-#include "immerse/simulation/Scenario.hpp"
-#include "immerse/simulation/ShearPlaneProfile.hpp"
 
 namespace immerse {
 
