@@ -70,7 +70,9 @@ int TimeLoop::run() {
 // The scenario's work comes within the step, before its callbacks, so that a checkpoint of the step holds it.
 void TimeLoop::step_once() {
   const auto t0 = std::chrono::steady_clock::now();
-  const auto add_time = [&] { stepping_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(); };
+  const auto add_time = [&] {
+    stepping_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  };
   try {
     last_ = sim_.advance([this](const std::string& message) { log(message); },
                          [] { return StopSignals::received() != 0; });

@@ -1,7 +1,7 @@
 #pragma once
 // One run: the grid, the fluid, the membranes, their coupling and the time integrator, built from a resolved
-// configuration (RunSchema), advanced step by step. Output is not its business: run_command (app/RunCommand.hpp) schedules callbacks
-// (diagnostics, ParaView frames, checkpoints, progress) around advance().
+// configuration (RunSchema), advanced step by step. Output is not its business: run_command (app/RunCommand.hpp)
+// schedules callbacks (diagnostics, ParaView frames, checkpoints, progress) around advance().
 #include <memory>
 #include <optional>
 #include <string>
