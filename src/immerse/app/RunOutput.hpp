@@ -1,11 +1,7 @@
 #pragma once
-// The output of `immerse run`: the checks that its folder may take the run, the first files (config.resolved.toml,
-// mesh copies, column tables), and the callbacks that write diagnostics rows, ParaView frames and checkpoints on
-// their schedules (output.*_every).
-//
-// The folder belongs to the run: locked while it runs; one that holds another run is refused unless this run
-// continues it (--restart of its checkpoint) or replaces it (--overwrite). A restart into another folder branches
-// the run: a new series of rows, frames and checkpoints that begins at the checkpoint's step.
+// The output of `immerse run`: its folder (locked; another run's is refused unless continued or replaced), the first
+// files, and the callbacks that write diagnostics rows, ParaView frames and checkpoints on their schedules. A restart
+// into another folder branches the run: a new series that begins at the checkpoint's step.
 #include <filesystem>
 #include <iosfwd>
 #include <optional>
