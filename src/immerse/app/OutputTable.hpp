@@ -19,8 +19,6 @@ class OutputTable {
   /// in its folder (rows count from 0).
   OutputTable(std::string name, std::vector<Column> columns, std::function<bool(long, double)> keep);
 
-  const std::vector<Column>& columns() const { return columns_; }
-
   /// Continuing in `dir`: checks the table's header and reads the rows to keep (InputError if the file is damaged).
   /// Reads only.
   void read_kept_rows(const std::filesystem::path& dir);
