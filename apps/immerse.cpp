@@ -8,11 +8,11 @@
 #include <filesystem>
 #include <iostream>
 
+#include "immerse/app/RunCommand.hpp"
 #include "immerse/core/Error.hpp"
 #include "immerse/io/Provenance.hpp"
-#include "immerse/simulation/Runner.hpp"
 #include "immerse/timestep/PetscSession.hpp"
-#include "immerse/verify/Runner.hpp"
+#include "immerse/verify/StudyRunner.hpp"
 
 namespace {
 

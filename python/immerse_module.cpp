@@ -16,11 +16,12 @@
 #include <string>
 #include <vector>
 
+#include "immerse/app/Diagnostics.hpp"
+#include "immerse/app/Scenario.hpp"
+#include "immerse/app/ScenarioRun.hpp"
 #include "immerse/core/Error.hpp"
 #include "immerse/io/Config.hpp"
-#include "immerse/simulation/Diagnostics.hpp"
 #include "immerse/simulation/RunSchema.hpp"
-#include "immerse/simulation/Scenario.hpp"
 #include "immerse/simulation/Simulation.hpp"
 #include "immerse/timestep/PetscSession.hpp"
 
@@ -140,7 +141,9 @@ class PySimulation {
  public:
   explicit PySimulation(const io::Config& config) : petsc_(petsc_session()) {
     sim_ = std::make_unique<Simulation>(config);
-    columns_ = diagnostics_columns(sim_->config(), sim_->num_membranes());
+    scenario_ = make_scenario_run(sim_->config());
+    diagnostics_.emplace(sim_->config(), sim_->num_membranes(), *scenario_);
+    columns_ = column_names(diagnostics_->columns());
   }
 
   py::dict step() {
@@ -152,7 +155,7 @@ class PySimulation {
         py::print("immerse:", message, py::arg("file") = py::module_::import("sys").attr("stderr"));
       });
     }
-    const auto row = diagnostics_row(*sim_, r);
+    const auto row = diagnostics_->row(*sim_, r);
     py::dict d;
     for (std::size_t c = 0; c < columns_.size(); ++c) d[py::str(columns_[c])] = row[c];
     d["rejected"] = r.rejected;
@@ -183,6 +186,7 @@ class PySimulation {
   const Simulation& sim() const { return *sim_; }
   Simulation& sim() { return *sim_; }
   const std::vector<std::string>& columns() const { return columns_; }
+  const Diagnostics& diagnostics() const { return *diagnostics_; }
 
   void check_membrane(std::size_t m) const {
     if (m >= sim_->num_membranes())
@@ -193,6 +197,8 @@ class PySimulation {
  private:
   std::shared_ptr<PetscSession> petsc_;  // declared first: destroyed after the simulation's PETSc objects
   std::unique_ptr<Simulation> sim_;
+  std::unique_ptr<ScenarioRun> scenario_;  // the columns the scenario kind adds
+  std::optional<Diagnostics> diagnostics_;
   std::vector<std::string> columns_;
 };
 
@@ -228,7 +234,7 @@ line's --set: a dict {"scenario.G": 0.1, ...} or a list of "KEY=VALUE" strings. 
           "units",
           [](const PySimulation& s) {
             py::dict units;
-            for (const auto& c : diagnostics_column_info(s.sim().config(), s.sim().num_membranes()))
+            for (const auto& c : s.diagnostics().columns())
               units[py::str(c.name)] = c.unit;
             return units;
           },

@@ -6,8 +6,8 @@
 
 #include "immerse/core/Error.hpp"
 #include "immerse/coupling/DeltaKernel.hpp"
-#include "immerse/verify/Runner.hpp"
 #include "immerse/verify/Study.hpp"
+#include "immerse/verify/StudyRunner.hpp"
 
 using namespace immerse;
 

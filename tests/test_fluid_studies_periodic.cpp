@@ -4,8 +4,8 @@
 
 #include <iostream>
 
-#include "immerse/verify/Runner.hpp"
 #include "immerse/verify/Study.hpp"
+#include "immerse/verify/StudyRunner.hpp"
 
 using namespace immerse::verify;
 

@@ -4,7 +4,7 @@
 #include <iostream>
 
 #include "PetscEnvironment.hpp"
-#include "immerse/verify/Runner.hpp"
+#include "immerse/verify/StudyRunner.hpp"
 
 using namespace immerse::verify;
 

@@ -7,11 +7,11 @@
 #include <sstream>
 
 #include "PetscEnvironment.hpp"
+#include "immerse/app/RunCommand.hpp"
+#include "immerse/app/Scenario.hpp"
 #include "immerse/io/Checkpoint.hpp"
 #include "immerse/io/Hdf5.hpp"
 #include "immerse/simulation/RunSchema.hpp"
-#include "immerse/simulation/Runner.hpp"
-#include "immerse/simulation/Scenario.hpp"
 #include "test_run_support.hpp"
 
 using namespace immerse;

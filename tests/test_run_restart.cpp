@@ -6,8 +6,8 @@
 #include <sstream>
 
 #include "PetscEnvironment.hpp"
+#include "immerse/app/RunCommand.hpp"
 #include "immerse/io/Checkpoint.hpp"
-#include "immerse/simulation/Runner.hpp"
 #include "test_run_support.hpp"
 
 using namespace immerse;

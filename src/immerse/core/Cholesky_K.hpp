@@ -1,7 +1,7 @@
 #pragma once
 // Cholesky factorization M = L L^T of a small dense symmetric matrix and the solve with it: the normal equations of
-// the small least-squares fits (CurvatureFit's local quartic, ErrorRecurrence's recurrence). Row-major n x n with row
-// stride `stride`, in place: the lower triangle becomes L.
+// the small least-squares fits (CurvatureFit's local quartic, GuessErrorPredictor's recurrence). Row-major n x n with
+// row stride `stride`, in place: the lower triangle becomes L.
 #include <cmath>
 
 namespace immerse {

@@ -90,7 +90,7 @@ CurvatureFit::CurvatureFit(const Mesh& mesh, const std::vector<Vec3>& reference)
   }
 }
 
-void CurvatureFit::compute(const std::vector<Vec3>& X, std::vector<Vec3>& normal, std::vector<Mat3>& kappa) const {
+void CurvatureFit::compute(std::span<const Vec3> X, std::vector<Vec3>& normal, std::vector<Mat3>& kappa) const {
   const int N = static_cast<int>(start_.size()) - 1;
   normal.resize(N);
   kappa.resize(N);

@@ -22,6 +22,7 @@
 // Verified by: the tests MembraneForce.CurvatureFit* (normal and mean curvature on an ellipsoid converge, kappa
 // tangent; a degenerate neighbourhood refused) and the study membrane_bending (linearized load of a Y_lm sphere).
 #include <cstddef>
+#include <span>
 #include <vector>
 
 #include "immerse/core/Mat3.hpp"
@@ -37,7 +38,7 @@ class CurvatureFit {
   CurvatureFit(const Mesh& mesh, const std::vector<Vec3>& reference);
 
   /// Unit normal N_i and curvature tensor kappa_i at every node of the configuration X.
-  void compute(const std::vector<Vec3>& X, std::vector<Vec3>& normal, std::vector<Mat3>& kappa) const;
+  void compute(std::span<const Vec3> X, std::vector<Vec3>& normal, std::vector<Mat3>& kappa) const;
 
   std::size_t memory_bytes() const {
     return (start_.size() + nbr_.size()) * sizeof(int) + weights_.size() * sizeof(double);

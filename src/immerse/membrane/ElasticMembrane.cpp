@@ -81,7 +81,7 @@ constexpr std::array<EdgePoint, 3> edge_points() {
 constexpr auto kEdgePoints = edge_points();
 
 
-Nodes element_nodes(const std::array<int, 6>& el, const std::vector<Vec3>& X) {
+Nodes element_nodes(const std::array<int, 6>& el, std::span<const Vec3> X) {
   Nodes x;
   for (int i = 0; i < tri6::kNodes; ++i) x[i] = X[el[i]];
   return x;
@@ -95,12 +95,12 @@ Nodes element_nodes(const std::array<int, 6>& el, const std::vector<Vec3>& X) {
 }
 
 [[gnu::always_inline]] inline Vec3 chord_normal(const Nodes& x) { return cross(x[1] - x[0], x[2] - x[0]); }
-[[gnu::always_inline]] inline Vec3 chord_normal(const std::array<int, 6>& el, const std::vector<Vec3>& X) {
+[[gnu::always_inline]] inline Vec3 chord_normal(const std::array<int, 6>& el, std::span<const Vec3> X) {
   return cross(X[el[1]] - X[el[0]], X[el[2]] - X[el[0]]);
 }
 
 /// Tangents at local node k of element el.
-[[gnu::always_inline]] inline Tangents slot_tangents(const std::array<int, 6>& el, int k, const std::vector<Vec3>& X) {
+[[gnu::always_inline]] inline Tangents slot_tangents(const std::array<int, 6>& el, int k, std::span<const Vec3> X) {
   Tangents t;
   node_derivatives(k, [&](int j) { return X[el[j]]; }, t.a_xi, t.a_eta);
   return t;
@@ -216,7 +216,7 @@ ElasticMembrane::ElasticMembrane(const Mesh& mesh, std::vector<Vec3> reference, 
   if (constraint.volume != 0 || constraint.area != 0) constraint_.emplace(mesh, mesh.nodes, constraint);
 }
 
-void ElasticMembrane::check_size(const std::vector<Vec3>& X) const {
+void ElasticMembrane::check_size(std::span<const Vec3> X) const {
   require(X.size() == reference_.size(), "membrane position count", static_cast<double>(X.size()),
           "equal to the node count " + std::to_string(reference_.size()));
 }
@@ -227,7 +227,7 @@ void ElasticMembrane::check_size(const std::vector<Vec3>& X) const {
 // Normal n and (optionally) tension (17)-(20), (18) from (39) at each element node, averaged at the nodes. The
 // element-node values are computed element by element (an element's six nodes gathered once, its chord normal
 // once) into per-slot arrays, then averaged node by node.
-void ElasticMembrane::node_pass(const std::vector<Vec3>& X, bool with_tension, Work& w) const {
+void ElasticMembrane::node_pass(std::span<const Vec3> X, bool with_tension, Work& w) const {
   const int N = static_cast<int>(num_nodes()), E = static_cast<int>(num_elements());
   w.slot_n.resize(6 * static_cast<std::size_t>(E));
   if (with_tension) w.slot_tau.resize(6 * static_cast<std::size_t>(E));
@@ -280,7 +280,7 @@ void ElasticMembrane::node_pass(const std::vector<Vec3>& X, bool with_tension, W
 
 // Bending moments (25), m = kappa_B (kappa - kappa_m^R P), P = I - N N, with the nodal normal N and curvature
 // tensor kappa (40) from the local quartic fit (CurvatureFit).
-void ElasticMembrane::moment_pass(const std::vector<Vec3>& X, Work& w) const {
+void ElasticMembrane::moment_pass(std::span<const Vec3> X, Work& w) const {
   const int N = static_cast<int>(num_nodes());
   fit_->compute(X, w.node_nfit, w.node_kappa);
   w.node_m.resize(N);
@@ -291,7 +291,7 @@ void ElasticMembrane::moment_pass(const std::vector<Vec3>& X, Work& w) const {
 
 // Bending: moments (25) at the nodes; (P.grad).m = tr K (41) at element nodes from the interpolated nodal
 // moments, averaged; q (27) at nodes with the fitted normal's projector.
-void ElasticMembrane::bending_passes(const std::vector<Vec3>& X, Work& w) const {
+void ElasticMembrane::bending_passes(std::span<const Vec3> X, Work& w) const {
   const int N = static_cast<int>(num_nodes());
   moment_pass(X, w);
   w.node_q.resize(N);
@@ -314,7 +314,7 @@ void ElasticMembrane::bending_passes(const std::vector<Vec3>& X, Work& w) const 
 // Eq. (42): F_e = S_e fbar_e = oint [b.tau + (b.q) n] dl, b dl = (dX/ds x n) ds along each curved edge, with
 // tau, q, n interpolated quadratically from the nodal values. The tension part is linear in the nodal tau:
 // sum_g w_g tau(s_g) b_g = sum_j tau_j beta_j, beta_j = sum_g w_g L_j(s_g) b_g, accumulated per element node.
-void ElasticMembrane::contour_forces(const std::vector<Vec3>& X, bool with_tension, bool with_bending,
+void ElasticMembrane::contour_forces(std::span<const Vec3> X, bool with_tension, bool with_bending,
                                      Work& w) const {
   const int E = static_cast<int>(num_elements());
   w.el_force.resize(E);
@@ -350,7 +350,7 @@ void ElasticMembrane::contour_forces(const std::vector<Vec3>& X, bool with_tensi
 }
 
 // F_i = -dE/dX_i = -sum_gp Jbar w (dN_i/dxi dW/da_xi + dN_i/deta dW/da_eta)   (see MembraneKinematics_K.hpp)
-void ElasticMembrane::energy_forces(const std::vector<Vec3>& X, Work& w) const {
+void ElasticMembrane::energy_forces(std::span<const Vec3> X, Work& w) const {
   const int E = static_cast<int>(num_elements());
   w.en_force.resize(6 * E);
   int bad = INT_MAX;
@@ -382,7 +382,7 @@ void ElasticMembrane::energy_forces(const std::vector<Vec3>& X, Work& w) const {
   throw_if_bad(bad);
 }
 
-void ElasticMembrane::compute_force(const std::vector<Vec3>& X, std::vector<Vec3>& F) const {
+void ElasticMembrane::compute_force(std::span<const Vec3> X, std::vector<Vec3>& F) const {
   check_size(X);
   Work& w = workspace();
   const bool energy = method_ == ForceMethod::Energy;
@@ -414,7 +414,7 @@ void ElasticMembrane::compute_force(const std::vector<Vec3>& X, std::vector<Vec3
 }
 
 
-double ElasticMembrane::compute_energy(const std::vector<Vec3>& X) const {
+double ElasticMembrane::compute_energy(std::span<const Vec3> X) const {
   check_size(X);
   const int E = static_cast<int>(num_elements());
   std::vector<double> energy(E);
@@ -446,7 +446,7 @@ double ElasticMembrane::compute_energy(const std::vector<Vec3>& X) const {
   return total;
 }
 
-std::vector<NodeStrain> ElasticMembrane::node_strain(const std::vector<Vec3>& X) const {
+std::vector<NodeStrain> ElasticMembrane::node_strain(std::span<const Vec3> X) const {
   check_size(X);
   const int E = static_cast<int>(num_elements());
   std::vector<Vec3> en_inv(6 * E);  // (A1, A2, (lambda1^2 - lambda2^2)/2) per element node
@@ -479,7 +479,7 @@ std::vector<NodeStrain> ElasticMembrane::node_strain(const std::vector<Vec3>& X)
   return out;
 }
 
-std::vector<double> ElasticMembrane::node_area(const std::vector<Vec3>& X) const {
+std::vector<double> ElasticMembrane::node_area(std::span<const Vec3> X) const {
   check_size(X);
   const int E = static_cast<int>(num_elements());
   std::vector<double> S(E);
@@ -499,7 +499,7 @@ std::vector<double> ElasticMembrane::node_area(const std::vector<Vec3>& X) const
   return a;
 }
 
-std::vector<Vec3> ElasticMembrane::node_normal(const std::vector<Vec3>& X) const {
+std::vector<Vec3> ElasticMembrane::node_normal(std::span<const Vec3> X) const {
   check_size(X);
   Work w;
   node_pass(X, false, w);

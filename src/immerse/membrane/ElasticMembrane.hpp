@@ -21,6 +21,7 @@
 // membrane_force_agreement, membrane_momentum and membrane_bending, and the tests MembraneForce.*.
 #include <cstddef>
 #include <optional>
+#include <span>
 #include <vector>
 
 #include "immerse/core/Vec3.hpp"
@@ -56,22 +57,21 @@ class ElasticMembrane {
   ElasticMembrane(const Mesh& mesh, std::vector<Vec3> reference, MaterialLaw law, Bending bending,
                   ForceMethod method, ConstraintModuli constraint = {});
 
-  /// Nodal forces F (N) exerted by the membrane at positions X (resized to the node count), constraint forces
-  /// included. Thread-safe for
-  /// concurrent calls; OpenMP inside; independent of the thread count. SimulationError naming the element if
-  /// one inverts or degenerates (Jacobian <= 0 or not finite).
-  void compute_force(const std::vector<Vec3>& X, std::vector<Vec3>& F) const;
+  /// Nodal forces F (N) exerted by the membrane at positions X (read in place; F resized to the node count),
+  /// constraint forces included. Thread-safe for concurrent calls; OpenMP inside; independent of the thread count.
+  /// SimulationError naming the element if one inverts or degenerates (Jacobian <= 0 or not finite).
+  void compute_force(std::span<const Vec3> X, std::vector<Vec3>& F) const;
   /// Discrete in-plane elastic energy E (J) = sum_e sum_gp W(A1, A2) Jbar w (without the constraints' energy).
-  double compute_energy(const std::vector<Vec3>& X) const;
+  double compute_energy(std::span<const Vec3> X) const;
 
   /// Strain and tension at each node: invariants A1, A2 at the element nodes averaged over the elements sharing
   /// the node, principal stretches from them and principal tensions from (18) in principal axes.
-  std::vector<NodeStrain> node_strain(const std::vector<Vec3>& X) const;
+  std::vector<NodeStrain> node_strain(std::span<const Vec3> X) const;
   /// Lumped area a_i (m^2) each node carries at X; sum_i a_i = total area. Force density at node i = F_i / a_i
   /// for the contour method.
-  std::vector<double> node_area(const std::vector<Vec3>& X) const;
+  std::vector<double> node_area(std::span<const Vec3> X) const;
   /// Unit normal at each node: normalized average of the normals of the elements sharing it (used by eq. 42).
-  std::vector<Vec3> node_normal(const std::vector<Vec3>& X) const;
+  std::vector<Vec3> node_normal(std::span<const Vec3> X) const;
   /// kappa_m^R of eq. (25) per node (1/m); zero unless kappa_B > 0 with ReferenceCurvature::RestShape.
   const std::vector<double>& reference_curvature() const { return kappa_ref_; }
 
@@ -88,12 +88,12 @@ class ElasticMembrane {
  private:
   struct Work;
   static Work& workspace();  ///< compute_force's scratch data, one per calling thread
-  void check_size(const std::vector<Vec3>& X) const;
-  void node_pass(const std::vector<Vec3>& X, bool with_tension, Work& w) const;
-  void moment_pass(const std::vector<Vec3>& X, Work& w) const;
-  void bending_passes(const std::vector<Vec3>& X, Work& w) const;
-  void contour_forces(const std::vector<Vec3>& X, bool with_tension, bool with_bending, Work& w) const;
-  void energy_forces(const std::vector<Vec3>& X, Work& w) const;
+  void check_size(std::span<const Vec3> X) const;
+  void node_pass(std::span<const Vec3> X, bool with_tension, Work& w) const;
+  void moment_pass(std::span<const Vec3> X, Work& w) const;
+  void bending_passes(std::span<const Vec3> X, Work& w) const;
+  void contour_forces(std::span<const Vec3> X, bool with_tension, bool with_bending, Work& w) const;
+  void energy_forces(std::span<const Vec3> X, Work& w) const;
   std::vector<double> reference_mean_curvature() const;
 
   std::vector<std::array<int, 6>> elements_;

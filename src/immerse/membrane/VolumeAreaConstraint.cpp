@@ -82,7 +82,7 @@ ElementPart element_part(const std::array<Vec3, 6>& x, bool with_area) {
 
 }  // namespace
 
-SurfaceGradients surface_gradients(const std::vector<std::array<int, 6>>& elements, const std::vector<Vec3>& X,
+SurfaceGradients surface_gradients(const std::vector<std::array<int, 6>>& elements, std::span<const Vec3> X,
                                    bool with_area) {
   Vec3 origin;
   for (const auto& x : X) origin += x;
@@ -119,7 +119,7 @@ VolumeAreaConstraint::VolumeAreaConstraint(const Mesh& mesh, const std::vector<V
   require(V0_ > 0, "membrane volume", V0_, "> 0 (a closed surface oriented outwards)");
 }
 
-void VolumeAreaConstraint::add_force(const std::vector<Vec3>& X, std::vector<Vec3>& F) const {
+void VolumeAreaConstraint::add_force(std::span<const Vec3> X, std::vector<Vec3>& F) const {
   const SurfaceGradients g = surface_gradients(elements_, X, moduli_.area > 0);
   const double cV = -moduli_.volume * (g.volume - V0_) / V0_;
   const double cA = moduli_.area > 0 ? -moduli_.area * (g.area - A0_) / A0_ : 0.0;
@@ -129,7 +129,7 @@ void VolumeAreaConstraint::add_force(const std::vector<Vec3>& X, std::vector<Vec
   }
 }
 
-double VolumeAreaConstraint::energy(const std::vector<Vec3>& X) const {
+double VolumeAreaConstraint::energy(std::span<const Vec3> X) const {
   const SurfaceGradients g = surface_gradients(elements_, X, true);
   const double dV = g.volume - V0_, dA = g.area - A0_;
   return moduli_.volume * dV * dV / (2 * V0_) + moduli_.area * dA * dA / (2 * A0_);

@@ -17,6 +17,7 @@
 // zero force at V0 and A0, zero net force and torque, an inflated sphere relaxing back).
 #include <array>
 #include <cstddef>
+#include <span>
 #include <vector>
 
 #include "immerse/core/Vec3.hpp"
@@ -39,7 +40,7 @@ struct SurfaceGradients {
 
 /// V, A (the values of Geometry's volume() and area() up to round-off) and dV/dX, and dA/dX when `with_area`.
 /// Independent of the thread count.
-SurfaceGradients surface_gradients(const std::vector<std::array<int, 6>>& elements, const std::vector<Vec3>& X,
+SurfaceGradients surface_gradients(const std::vector<std::array<int, 6>>& elements, std::span<const Vec3> X,
                                    bool with_area);
 
 class VolumeAreaConstraint {
@@ -48,9 +49,9 @@ class VolumeAreaConstraint {
   VolumeAreaConstraint(const Mesh& mesh, const std::vector<Vec3>& X0, ConstraintModuli moduli);
 
   /// F_i += -dE/dX_i for E = E_V + E_A at X.
-  void add_force(const std::vector<Vec3>& X, std::vector<Vec3>& F) const;
+  void add_force(std::span<const Vec3> X, std::vector<Vec3>& F) const;
   /// E_V + E_A (J) at X.
-  double energy(const std::vector<Vec3>& X) const;
+  double energy(std::span<const Vec3> X) const;
 
   double volume0() const { return V0_; }
   double area0() const { return A0_; }

@@ -78,7 +78,6 @@ ImmersedBoundaryOperator::ImmersedBoundaryOperator(NavierStokesSolver& fluid, IB
                        " initial positions for a mesh of " + std::to_string(membranes_[m]->num_nodes()) + " nodes");
     offset_.push_back(X_.size());
     X_.insert(X_.end(), X0[m].begin(), X0[m].end());
-    Xm_.emplace_back(X0[m].size());
     Fm_.emplace_back(X0[m].size());
   }
   offset_.push_back(X_.size());
@@ -96,11 +95,10 @@ ImmersedBoundaryOperator::ImmersedBoundaryOperator(NavierStokesSolver& fluid, IB
 }
 
 void ImmersedBoundaryOperator::nodal_force(std::size_t m, std::span<const Vec3> X) {
-  std::copy(X.begin() + static_cast<std::ptrdiff_t>(offset_[m]), X.begin() + static_cast<std::ptrdiff_t>(offset_[m + 1]),
-            Xm_[m].begin());
+  const std::span<const Vec3> Xm = X.subspan(offset_[m], offset_[m + 1] - offset_[m]);
   try {
-    check_nodes_in_domain(fluid_.grid(), Xm_[m]);
-    membranes_[m]->compute_force(Xm_[m], Fm_[m]);
+    check_nodes_in_domain(fluid_.grid(), Xm);
+    membranes_[m]->compute_force(Xm, Fm_[m]);
   } catch (const SimulationError& e) {
     throw SimulationError("membrane[" + std::to_string(m) + "] " + e.what());
   }

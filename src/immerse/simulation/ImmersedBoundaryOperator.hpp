@@ -117,7 +117,7 @@ class ImmersedBoundaryOperator final : public CoupledOperator {
   std::vector<Vec3> applied_;                           ///< external nodal forces, all membranes
   std::optional<ContactForce> contact_;                 ///< when its range is positive
   std::vector<Vec3> contact_F_;                         ///< contact forces, all membranes
-  std::vector<std::vector<Vec3>> Xm_, Fm_;              ///< per-membrane scratch for compute_force
+  std::vector<std::vector<Vec3>> Fm_;                   ///< per-membrane forces of compute_force
   std::size_t solves_ = 0;
   StepTimings timings_;
   ThreadGovernor governor_;

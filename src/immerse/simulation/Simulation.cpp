@@ -20,7 +20,7 @@
 #include "immerse/membrane/Yeoh.hpp"
 #include "immerse/simulation/CellPacking.hpp"
 #include "immerse/simulation/MembraneClearance.hpp"
-#include "immerse/simulation/Scenario.hpp"
+#include "immerse/app/Scenario.hpp"
 #include "immerse/timestep/DenseBfgs.hpp"
 
 namespace immerse {

@@ -1,7 +1,7 @@
 #pragma once
 // One run: the grid, the fluid, the membranes, their coupling and the time integrator, built from a resolved
-// configuration (RunSchema), advanced step by step. Output is not its business: the Runner schedules callbacks
-// (diagnostics, ParaView frames, checkpoints, progress) around advance().
+// configuration (RunSchema), advanced step by step. Output is not its business: run_command (app/RunCommand.hpp)
+// schedules callbacks (diagnostics, ParaView frames, checkpoints, progress) around advance().
 #include <memory>
 #include <optional>
 #include <string>
@@ -24,7 +24,7 @@ namespace immerse {
 struct StepRecord {
   long step = 0;
   double time = 0, dt = 0;
-  StepStats stats;
+  SolverStats stats;
   int rejected = 0;
   double wall_seconds = 0;
 };

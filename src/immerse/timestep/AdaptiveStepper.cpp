@@ -23,7 +23,7 @@ AdaptiveStepper::Accepted AdaptiveStepper::advance(MembraneIntegrator& integrato
   int rejected = 0;
   for (;;) {
     const double dt = std::min(dt_, max_dt);
-    StepStats st = integrator.step(op, dt);
+    SolverStats st = integrator.step(op, dt);
     if (st.converged) {
       st.fluid_solves = op.fluid_solves() - solves0;
       if (dt_ < nominal_ && ++successes_ >= grow_after_) {

@@ -17,7 +17,7 @@ class AdaptiveStepper {
   AdaptiveStepper(double dt_nominal, double dt_min, int grow_after = 4);
 
   struct Accepted {
-    StepStats stats;  ///< of the accepted attempt (fluid solves include the rejected attempts)
+    SolverStats stats;  ///< of the accepted attempt (fluid solves include the rejected attempts)
     double dt;        ///< the step taken
     int rejected;     ///< attempts rejected before it
   };

@@ -27,24 +27,25 @@ class CoupledOperator {
   virtual double length_scale() const = 0;
 
   /// One fluid step of length dt from the committed state, driven by the membrane force density
-  ///   F^{n+1/2} = (1 - theta) S(X^n) f(X^n) + theta S(Xf) f(Xf),
-  /// returning U = J(Xi) u^{n+1}. Pure in the committed state: the new fluid state is kept as the trial.
-  /// Throws SimulationError when a node leaves the domain or an element inverts.
-  virtual void trial_velocity(std::span<const double> Xf, double theta, std::span<const double> Xi, double dt,
-                              std::span<double> U) = 0;
-  /// U = J(Xi) u^n for the committed fluid velocity.
-  virtual void committed_velocity(std::span<const double> Xi, std::span<double> U) = 0;
-  /// The midpoint rule's velocity: the fluid step of trial_velocity(Xf, 1, Xi, dt, ·), returning the step's mean node
-  /// velocity U = J(Xi) (u^n + u^{n+1}) / 2. Here two interpolations; an operator may interpolate the mean field once
-  /// (J is linear in u).
-  virtual void trial_mean_velocity(std::span<const double> Xf, std::span<const double> Xi, double dt,
+  ///   F^{n+1/2} = (1 - theta) S(X^n) f(X^n) + theta S(X_force) f(X_force),
+  /// returning U = J(X_interp) u^{n+1}: the force is taken at X_force, the velocity interpolated at X_interp (every
+  /// integrator here passes the same positions for both). Pure in the committed state: the new fluid state is kept as
+  /// the trial. Throws SimulationError when a node leaves the domain or an element inverts.
+  virtual void trial_velocity(std::span<const double> X_force, double theta, std::span<const double> X_interp,
+                              double dt, std::span<double> U) = 0;
+  /// U = J(X_interp) u^n for the committed fluid velocity.
+  virtual void committed_velocity(std::span<const double> X_interp, std::span<double> U) = 0;
+  /// The midpoint rule's velocity: the fluid step of trial_velocity(X_force, 1, X_interp, dt, ·), returning the step's
+  /// mean node velocity U = J(X_interp) (u^n + u^{n+1}) / 2. Here two interpolations; an operator may interpolate the
+  /// mean field once (J is linear in u).
+  virtual void trial_mean_velocity(std::span<const double> X_force, std::span<const double> X_interp, double dt,
                                    std::span<double> U) {
     std::vector<double> Un(U.size());
-    trial_velocity(Xf, 1.0, Xi, dt, U);
-    committed_velocity(Xi, Un);
+    trial_velocity(X_force, 1.0, X_interp, dt, U);
+    committed_velocity(X_interp, Un);
     for (std::size_t i = 0; i < U.size(); ++i) U[i] = 0.5 * (Un[i] + U[i]);
   }
-  /// True when the last trial_velocity call completed with Xf = X exactly: its trial state is then the one the
+  /// True when the last trial_velocity call completed with X_force = X exactly: its trial state is then the one the
   /// positions X drive, ready to be committed.
   virtual bool trial_matches(std::span<const double> X) const = 0;
   /// Accepts the step: X^{n+1} = X, the fluid state becomes the trial of the last trial_velocity call, and

@@ -17,13 +17,13 @@ double dot(const std::vector<double>& a, const std::vector<double>& b) {
 
 DenseBfgs::DenseBfgs(const SolverSettings& settings) : settings_(settings) { settings_.validate(); }
 
-StepStats DenseBfgs::step(CoupledOperator& op, double dt) {
+SolverStats DenseBfgs::step(CoupledOperator& op, double dt) {
   const std::size_t n = op.size(), solves0 = op.fluid_solves();
   if (n > max_unknowns)
     throw InputError("time.scheme = 'bfgs': the dense quasi-Newton matrix needs " + std::to_string(n) + "^2 entries; " +
                      "it is limited to " + std::to_string(max_unknowns) +
                      " unknowns (use 'jfnk', 'anderson' or 'lbfgs')");
-  StepStats stats;
+  SolverStats stats;
   ThetaResidual g(op, dt, settings_.theta);
   X_.resize(n);
   g_.resize(n);

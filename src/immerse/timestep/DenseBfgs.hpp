@@ -6,7 +6,7 @@
 //   H_{k+1} = H_k + (1 + q^T H q / p^T q) p p^T / p^T q - (p q^T H + H q p^T) / p^T q,
 //
 // starting each step from H_0 = I (J = I - (dt/2) u' of eq. (32) is close to I) and the X^(0) of the other
-// implicit schemes (MembraneIntegrator::initial_guess: 2X^n - X^{n-1}, corrected by ErrorRecurrence by default).
+// implicit schemes (MembraneIntegrator::initial_guess: 2X^n - X^{n-1}, corrected by GuessErrorPredictor by default).
 // H is n x n (n = 3 x nodes): §2.4.2 explains why this cannot run on the 3D meshes of §4; use "lbfgs" there.
 // Verified by: the study quasi_newton_agreement (reaches JFNK's X^{n+1}, ≤ 1e-9 relative) and the tests
 // Integrators.QuasiNewtonVariantsAreSecondOrder and Integrators.QuasiNewtonAndAndersonAndJfnkReachTheSameStep.
@@ -19,7 +19,7 @@ class DenseBfgs final : public MembraneIntegrator {
   /// Largest number of unknowns accepted (the n x n matrix must fit comfortably in memory).
   static constexpr std::size_t max_unknowns = 12000;
   explicit DenseBfgs(const SolverSettings& settings);
-  StepStats step(CoupledOperator& op, double dt) override;
+  SolverStats step(CoupledOperator& op, double dt) override;
   std::string name() const override { return "bfgs"; }
 
  private:

@@ -2,7 +2,7 @@
 
 namespace immerse {
 
-StepStats ForwardEuler::step(CoupledOperator& op, double dt) {
+SolverStats ForwardEuler::step(CoupledOperator& op, double dt) {
   const std::size_t n = op.size(), solves0 = op.fluid_solves();
   const auto Xn = op.positions();
   const auto Un = op.node_velocity();
@@ -12,7 +12,7 @@ StepStats ForwardEuler::step(CoupledOperator& op, double dt) {
   op.trial_velocity(X_, 1.0, X_, dt, U_);
   remember(op, dt);
   op.commit(X_, dt);
-  StepStats s;
+  SolverStats s;
   s.fluid_solves = op.fluid_solves() - solves0;
   return s;
 }

@@ -10,7 +10,7 @@ namespace immerse {
 
 class ForwardEuler final : public MembraneIntegrator {
  public:
-  StepStats step(CoupledOperator& op, double dt) override;
+  SolverStats step(CoupledOperator& op, double dt) override;
   std::string name() const override { return "euler"; }
 
  private:

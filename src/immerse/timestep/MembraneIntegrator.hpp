@@ -6,15 +6,16 @@
 #include <vector>
 
 #include "immerse/timestep/CoupledOperator.hpp"
-#include "immerse/timestep/ErrorRecurrence.hpp"
-#include "immerse/timestep/StepStats.hpp"
+#include "immerse/timestep/GuessErrorPredictor.hpp"
+#include "immerse/timestep/SolverStats.hpp"
 #include "immerse/timestep/ThetaResidual.hpp"
 
 namespace immerse {
 
 /// Nonlinear-solver settings of the implicit schemes (§4: GMRES rtol 1e-3, Newton ||g||/||X|| < 1e-8).
 struct SolverSettings {
-  /// Newton's starting point: the linear extrapolation of §3 step 1, or that plus the error ErrorRecurrence predicts.
+  /// Newton's starting point: the linear extrapolation of §3 step 1, or that plus the error GuessErrorPredictor
+  /// predicts.
   enum class InitialGuess { Extrapolation, Recurrence };
   double theta = 0.5;           ///< theta-method weight: 1/2 is the trapezoidal rule (29), 1 backward Euler
   double newton_rtol = 1e-8;    ///< stop when ||g|| / ||X|| < newton_rtol
@@ -33,7 +34,7 @@ class MembraneIntegrator {
   virtual ~MembraneIntegrator() = default;
   /// Attempts one step of length dt. On success the operator is committed; on failure nothing is
   /// (stats.converged == false, stats.failure says why).
-  virtual StepStats step(CoupledOperator& op, double dt) = 0;
+  virtual SolverStats step(CoupledOperator& op, double dt) = 0;
   virtual std::string name() const = 0;
   /// Sets the scheme up for `unknowns` unknowns before the first step, so that a run reports solver options PETSc
   /// rejects (InputError) before it writes anything. Optional: step() sets up what it needs.
@@ -41,16 +42,16 @@ class MembraneIntegrator {
 
   /// Positions X^{n-1} and step dt^{n-1} before the committed ones, used by the implicit schemes' initial guess
   /// X^(0) = X^n + (dt/dt^{n-1})(X^n - X^{n-1}) (step 1 of §3); empty before the first step. Saved in checkpoints,
-  /// with the errors of the last extrapolations (ErrorRecurrence, all recorded with step dt^{n-1}).
+  /// with the errors of the last extrapolations (GuessErrorPredictor, all recorded with step dt^{n-1}).
   const std::vector<double>& previous_positions() const { return prev_X_; }
   double previous_dt() const { return prev_dt_; }
-  const ErrorRecurrence& guess_errors() const { return errors_; }
+  const GuessErrorPredictor& guess_errors() const { return errors_; }
   void set_history(std::vector<double> previous_positions, double previous_dt,
                    std::span<const double> guess_errors = {});
 
  protected:
   /// X^(0) of the implicit schemes: the linear extrapolation (ThetaResidual::initial_guess), plus the error
-  /// ErrorRecurrence predicts for it when `guess` is Recurrence.
+  /// GuessErrorPredictor predicts for it when `guess` is Recurrence.
   void initial_guess(const ThetaResidual& g, SolverSettings::InitialGuess guess, std::span<double> X0);
   /// Records X^n as history just before the operator commits X^{n+1} = X; an implicit scheme passes X, so that
   /// the error of its extrapolated X^(0) is recorded.
@@ -60,7 +61,7 @@ class MembraneIntegrator {
   std::vector<double> prev_X_;
   double prev_dt_ = 0;
   std::vector<double> extrapolated_;  // this step's linear extrapolation; empty when X^(0) was not one
-  ErrorRecurrence errors_;
+  GuessErrorPredictor errors_;
 };
 
 /// The schemes by name: "euler" (eq. 28), "rk2" (midpoint), "jfnk" (§2.4.3), "bfgs" (eq. 35, dense),

@@ -2,7 +2,7 @@
 
 namespace immerse {
 
-StepStats MidpointRK2::step(CoupledOperator& op, double dt) {
+SolverStats MidpointRK2::step(CoupledOperator& op, double dt) {
   const std::size_t n = op.size(), solves0 = op.fluid_solves();
   const auto Xn = op.positions();
   const auto Un = op.node_velocity();
@@ -14,7 +14,7 @@ StepStats MidpointRK2::step(CoupledOperator& op, double dt) {
   for (std::size_t i = 0; i < n; ++i) X_[i] = Xn[i] + dt * Um_[i];
   remember(op, dt);
   op.commit(X_, dt);
-  StepStats s;
+  SolverStats s;
   s.fluid_solves = op.fluid_solves() - solves0;
   return s;
 }

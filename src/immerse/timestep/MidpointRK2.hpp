@@ -18,7 +18,7 @@ namespace immerse {
 
 class MidpointRK2 final : public MembraneIntegrator {
  public:
-  StepStats step(CoupledOperator& op, double dt) override;
+  SolverStats step(CoupledOperator& op, double dt) override;
   std::string name() const override { return "rk2"; }
 
  private:

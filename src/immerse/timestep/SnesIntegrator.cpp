@@ -258,13 +258,13 @@ void SnesIntegrator::prepare(std::size_t unknowns) {
   if (!snes_) setup(unknowns);
 }
 
-StepStats SnesIntegrator::step(CoupledOperator& op, double dt) {
+SolverStats SnesIntegrator::step(CoupledOperator& op, double dt) {
   // PETSc's L-BFGS keeps its secant pairs from one solve to the next; each step starts afresh from H_0 = I instead,
   // so that a step depends only on the state a checkpoint holds (bitwise restarts).
   if (method_ == Method::LimitedMemoryBFGS) destroy();
   if (!snes_) setup(op.size());
   if (op.size() != n_) throw std::logic_error("SnesIntegrator: the number of unknowns changed");
-  StepStats stats;
+  SolverStats stats;
   const std::size_t solves0 = op.fluid_solves();
   ThetaResidual residual(op, dt, settings_.theta);
   residual_ = &residual;

@@ -2,7 +2,7 @@
 // Implicit membrane update solved with PETSc SNES (paper §2.4.2-2.4.3, algorithm of §3):
 //
 //   solve g(X^{n+1}) = 0, g from eq. (31) (theta-method; theta = 1/2 is the trapezoidal rule (29)),
-//   starting from X^(0) = 2X^n - X^{n-1} (step 1 of §3), plus the error ErrorRecurrence predicts for it when
+//   starting from X^(0) = 2X^n - X^{n-1} (step 1 of §3), plus the error GuessErrorPredictor predicts for it when
 //   solver.initial_guess = "recurrence" (the default),
 //   stopping when ||g|| / ||X|| < newton_rtol (§4: 1e-8).
 //
@@ -55,7 +55,7 @@ class SnesIntegrator final : public MembraneIntegrator {
   SnesIntegrator(const SnesIntegrator&) = delete;
   SnesIntegrator& operator=(const SnesIntegrator&) = delete;
 
-  StepStats step(CoupledOperator& op, double dt) override;
+  SolverStats step(CoupledOperator& op, double dt) override;
   std::string name() const override;
   /// Creates the PETSc solver with PETSC_OPTIONS and solver.petsc_options applied; a value PETSc rejects is an
   /// InputError.

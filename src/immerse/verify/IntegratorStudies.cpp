@@ -6,7 +6,7 @@
 
 #include "immerse/core/Error.hpp"
 #include "immerse/membrane/Geometry.hpp"
-#include "immerse/timestep/StepStats.hpp"
+#include "immerse/timestep/SolverStats.hpp"
 #include "immerse/verify/Convergence.hpp"
 #include "immerse/verify/OscillatingMembrane.hpp"
 #include "immerse/verify/Study.hpp"
@@ -94,7 +94,7 @@ Run run_stability(const std::string& scheme, int n, int level, double mu, double
   const int steps = static_cast<int>(std::lround(T / dt));
   const double req = OscillatingMembrane::equilibrium_radius();
   for (int k = 1; k <= steps; ++k) {
-    StepStats st;
+    SolverStats st;
     try {
       st = integ->step(exp.op(), dt);
     } catch (const SimulationError&) {

@@ -1,4 +1,4 @@
-// The implicit step's initial guess: ErrorRecurrence on sequences with known recurrences, its history rules, and
+// The implicit step's initial guess: GuessErrorPredictor on sequences with known recurrences, its history rules, and
 // its effect on JFNK (fewer fluid solves for the same steps).
 #include <gtest/gtest.h>
 #include <omp.h>
@@ -15,7 +15,7 @@
 #include "PetscEnvironment.hpp"
 #include "ToyOperator.hpp"
 #include "immerse/core/Error.hpp"
-#include "immerse/timestep/ErrorRecurrence.hpp"
+#include "immerse/timestep/GuessErrorPredictor.hpp"
 #include "immerse/verify/OscillatingMembrane.hpp"
 
 using namespace immerse;
@@ -44,7 +44,7 @@ double relative_difference(const std::vector<double>& a, const std::vector<doubl
   return std::sqrt(d / n);
 }
 
-std::vector<double> prediction(const ErrorRecurrence& r, double dt, std::size_t n,
+std::vector<double> prediction(const GuessErrorPredictor& r, double dt, std::size_t n,
                                std::span<const std::size_t> offsets = {}) {
   std::vector<double> x(n, 0.0);
   r.predict(dt, x, offsets);
@@ -63,8 +63,8 @@ std::vector<double> modes(int k, const std::vector<double>& r, std::size_t n, un
 
 }  // namespace
 
-TEST(ErrorRecurrence, PredictsARingingAndADecayingModeExactly) {
-  ErrorRecurrence r;
+TEST(GuessErrorPredictor, PredictsARingingAndADecayingModeExactly) {
+  GuessErrorPredictor r;
   for (int k = 0; k < 3; ++k) r.record(0.1, two_modes(k, 0.9, -0.95));
   EXPECT_EQ(r.terms(0.1), 2);
   EXPECT_LT(relative_difference(prediction(r, 0.1, 60), two_modes(3, 0.9, -0.95)), 1e-12);
@@ -73,8 +73,8 @@ TEST(ErrorRecurrence, PredictsARingingAndADecayingModeExactly) {
   EXPECT_LT(relative_difference(prediction(r, 0.1, 60), two_modes(4, 0.9, -0.95)), 1e-12);
 }
 
-TEST(ErrorRecurrence, UsesOneTermForASingleModeAndNoneForUnrelatedErrors) {
-  ErrorRecurrence one;
+TEST(GuessErrorPredictor, UsesOneTermForASingleModeAndNoneForUnrelatedErrors) {
+  GuessErrorPredictor one;
   for (int k = 1; k <= 2; ++k) one.record(0.1, two_modes(k, -0.95, 0.0));  // (0^k = 0 for k >= 1: one mode)
   EXPECT_EQ(one.terms(0.1), 1);
   EXPECT_LT(relative_difference(prediction(one, 0.1, 60), two_modes(3, -0.95, 0.0)), 1e-12);
@@ -82,22 +82,22 @@ TEST(ErrorRecurrence, UsesOneTermForASingleModeAndNoneForUnrelatedErrors) {
   EXPECT_EQ(one.terms(0.1), 1);
   EXPECT_LT(relative_difference(prediction(one, 0.1, 60), two_modes(4, -0.95, 0.0)), 1e-12);
 
-  ErrorRecurrence none;
+  GuessErrorPredictor none;
   for (unsigned k = 0; k < 3; ++k) none.record(0.1, random_vector(60, 10 + k));
   EXPECT_EQ(none.terms(0.1), 0);
   for (double x : prediction(none, 0.1, 60)) EXPECT_EQ(x, 0.0);
 }
 
-TEST(ErrorRecurrence, FitsUpToFiveTermsToTheLastTwoErrors) {
+TEST(GuessErrorPredictor, FitsUpToFiveTermsToTheLastTwoErrors) {
   const std::vector<double> r{0.95, 0.6, 0.1, -0.7, -0.97};
-  ErrorRecurrence rec;
+  GuessErrorPredictor rec;
   for (int k = 0; k < 7; ++k) rec.record(0.1, modes(k, r, 200, 20));
   EXPECT_EQ(rec.terms(0.1), 5);
   EXPECT_LT(relative_difference(prediction(rec, 0.1, 200), modes(7, r, 200, 20)), 1e-8);
 }
 
 // Two membranes with three modes each: one recurrence for all would need six terms; one per block is exact.
-TEST(ErrorRecurrence, FitsEachBlockItsOwnRecurrence) {
+TEST(GuessErrorPredictor, FitsEachBlockItsOwnRecurrence) {
   const std::vector<double> ra{0.9, 0.3, -0.95}, rb{0.7, -0.2, -0.8};
   auto both = [&](int k) {
     auto e = modes(k, ra, 150, 30);
@@ -106,7 +106,7 @@ TEST(ErrorRecurrence, FitsEachBlockItsOwnRecurrence) {
     return e;
   };
   const std::vector<std::size_t> offsets{0, 150, 240};
-  ErrorRecurrence rec;
+  GuessErrorPredictor rec;
   for (int k = 0; k < 7; ++k) rec.record(0.1, both(k));
   EXPECT_EQ(rec.terms(0.1, offsets), 3);
   EXPECT_LT(relative_difference(prediction(rec, 0.1, 240, offsets), both(7)), 1e-8);
@@ -115,9 +115,9 @@ TEST(ErrorRecurrence, FitsEachBlockItsOwnRecurrence) {
   EXPECT_THROW(rec.predict(0.1, X, std::vector<std::size_t>{0, 150}), std::logic_error);
 }
 
-TEST(ErrorRecurrence, PredictionDoesNotDependOnTheNumberOfThreads) {
+TEST(GuessErrorPredictor, PredictionDoesNotDependOnTheNumberOfThreads) {
   const std::vector<std::size_t> offsets{0, 300, 600, 900, 1200};
-  ErrorRecurrence rec;
+  GuessErrorPredictor rec;
   for (int k = 0; k < 8; ++k) rec.record(0.1, modes(k, {0.9, 0.5, -0.3, -0.9}, 1200, 50));
   ASSERT_EQ(rec.terms(0.1, offsets), 4);
   const int threads = omp_get_max_threads();
@@ -132,7 +132,7 @@ TEST(ErrorRecurrence, PredictionDoesNotDependOnTheNumberOfThreads) {
 
 // A block whose recurrence stopped holding, an empty block and a block without errors predict nothing; the others
 // go on predicting.
-TEST(ErrorRecurrence, SkipsOnlyTheBlocksWhereNoRecurrenceHolds) {
+TEST(GuessErrorPredictor, SkipsOnlyTheBlocksWhereNoRecurrenceHolds) {
   const std::vector<double> ra{0.9, -0.95}, rb{0.7, -0.8};
   const std::vector<std::size_t> offsets{0, 100, 100, 180, 240};  // blocks a, (empty), b, zero
   auto errors = [&](int k, bool b_breaks) {
@@ -142,7 +142,7 @@ TEST(ErrorRecurrence, SkipsOnlyTheBlocksWhereNoRecurrenceHolds) {
     e.resize(240, 0.0);
     return e;
   };
-  ErrorRecurrence rec;
+  GuessErrorPredictor rec;
   for (int k = 0; k < 4; ++k) rec.record(0.1, errors(k, false));
   auto p = prediction(rec, 0.1, 240, offsets);
   EXPECT_LT(relative_difference(p, errors(4, false)), 1e-10);
@@ -158,8 +158,8 @@ TEST(ErrorRecurrence, SkipsOnlyTheBlocksWhereNoRecurrenceHolds) {
   EXPECT_LT(relative_difference(pa, ea), 1e-10);
 }
 
-TEST(ErrorRecurrence, StopsPredictingWhenItsLastPredictionMissedByMoreThanTheError) {
-  ErrorRecurrence r;
+TEST(GuessErrorPredictor, StopsPredictingWhenItsLastPredictionMissedByMoreThanTheError) {
+  GuessErrorPredictor r;
   for (int k = 0; k < 3; ++k) r.record(0.1, two_modes(k, 0.9, -0.95));
   ASSERT_EQ(r.terms(0.1), 2);
   // The recurrence stops holding: e^3 unrelated to the prediction two_modes(3), and of the same size.
@@ -173,8 +173,8 @@ TEST(ErrorRecurrence, StopsPredictingWhenItsLastPredictionMissedByMoreThanTheErr
   for (double x : prediction(r, 0.1, 60)) EXPECT_EQ(x, 0.0);
 }
 
-TEST(ErrorRecurrence, ForgetsItsHistoryWhenTheStepChanges) {
-  ErrorRecurrence r;
+TEST(GuessErrorPredictor, ForgetsItsHistoryWhenTheStepChanges) {
+  GuessErrorPredictor r;
   for (int k = 0; k < 3; ++k) r.record(0.1, two_modes(k, 0.9, -0.95));
   EXPECT_EQ(r.terms(0.05), 0);  // errors scale with dt: none predicted for another step
   for (double x : prediction(r, 0.05, 60)) EXPECT_EQ(x, 0.0);
@@ -183,8 +183,8 @@ TEST(ErrorRecurrence, ForgetsItsHistoryWhenTheStepChanges) {
   EXPECT_EQ(r.terms(0.05), 0);
 }
 
-TEST(ErrorRecurrence, RestoreOfItsErrorsIsBitwise) {
-  ErrorRecurrence r, s;
+TEST(GuessErrorPredictor, RestoreOfItsErrorsIsBitwise) {
+  GuessErrorPredictor r, s;
   const std::vector<double> modes_r{0.8, 0.4, -0.5, -0.97};
   auto noisy = [&](int k) {  // a recurrence plus noise: the fits are inexact and the miss rule is exercised
     auto e = modes(k, modes_r, 60, 60);
@@ -209,14 +209,14 @@ TEST(ErrorRecurrence, RestoreOfItsErrorsIsBitwise) {
 // The Gram matrices are kept from step to step (each new error's dot products computed once, the oldest error's
 // dropped with it): predictions made every step, by blocks that change now and then, are bitwise those of a
 // recurrence rebuilt from the same errors, whose matrices are computed afresh.
-TEST(ErrorRecurrence, KeptGramMatricesGiveThePredictionsOfFreshOnes) {
+TEST(GuessErrorPredictor, KeptGramMatricesGiveThePredictionsOfFreshOnes) {
   const std::vector<std::size_t> two{0, 90, 150}, three{0, 40, 90, 150};
-  ErrorRecurrence kept;
+  GuessErrorPredictor kept;
   int compared = 0;
   for (int k = 0; k < 16; ++k) {
     const auto& offsets = (k / 5) % 2 == 0 ? two : three;
     if (k > 0) {
-      ErrorRecurrence fresh;
+      GuessErrorPredictor fresh;
       fresh.restore(kept.errors(), 150, kept.dt());
       const auto p = prediction(kept, 0.1, 150, offsets);
       EXPECT_EQ(p, prediction(fresh, 0.1, 150, offsets)) << "step " << k;
@@ -232,7 +232,7 @@ TEST(ErrorRecurrence, KeptGramMatricesGiveThePredictionsOfFreshOnes) {
 
 // The integrators keep the errors of extrapolated guesses over equal steps only: none after the first step (its
 // guess is X^n + dt U^n), none across a change of step, none for an explicit scheme; at most eight.
-TEST(ErrorRecurrence, IntegratorsKeepTheErrorsOfEqualExtrapolatedStepsOnly) {
+TEST(GuessErrorPredictor, IntegratorsKeepTheErrorsOfEqualExtrapolatedStepsOnly) {
   auto stored = [](const MembraneIntegrator& m) { return m.guess_errors().errors().size() / 3; };
   immerse::testing::ToyOperator op({1.1, 2.0, 3.0}, {1.0, 2.0, 3.0}, 1e4, 0.5, 1.0);
   auto jfnk = make_integrator("jfnk", {});
@@ -252,7 +252,7 @@ TEST(ErrorRecurrence, IntegratorsKeepTheErrorsOfEqualExtrapolatedStepsOnly) {
 }
 
 // §4.1's membrane, steps of dt = dx: the same positions (to the Newton tolerance) for fewer fluid solves.
-TEST(ErrorRecurrence, CutsTheFluidSolvesOfJfnkStepsWithoutChangingThem) {
+TEST(GuessErrorPredictor, CutsTheFluidSolvesOfJfnkStepsWithoutChangingThem) {
   std::vector<std::vector<double>> X;
   std::vector<std::size_t> solves;
   for (auto guess : {SolverSettings::InitialGuess::Extrapolation, SolverSettings::InitialGuess::Recurrence}) {

@@ -1,4 +1,4 @@
-#include "immerse/simulation/ShearPlaneProfile.hpp"
+#include "immerse/app/ShearPlaneProfile.hpp"
 
 #include <array>
 #include <cmath>

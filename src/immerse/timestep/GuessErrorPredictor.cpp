@@ -1,4 +1,4 @@
-#include "immerse/timestep/ErrorRecurrence.hpp"
+#include "immerse/timestep/GuessErrorPredictor.hpp"
 
 #include <algorithm>
 #include <stdexcept>
@@ -10,7 +10,7 @@
 
 namespace immerse {
 
-void ErrorRecurrence::update_grams(const std::vector<std::size_t>& b) const {
+void GuessErrorPredictor::update_grams(const std::vector<std::size_t>& b) const {
   if (b != gram_blocks_) {
     gram_blocks_ = b;
     gram_rows_ = 0;
@@ -36,7 +36,7 @@ void ErrorRecurrence::update_grams(const std::vector<std::size_t>& b) const {
   gram_rows_ = m;
 }
 
-ErrorRecurrence::Fit ErrorRecurrence::fit(const Gram& G, std::size_t m, std::size_t unknowns) {
+GuessErrorPredictor::Fit GuessErrorPredictor::fit(const Gram& G, std::size_t m, std::size_t unknowns) {
   if (m < 2) return {};
   for (int t = static_cast<int>(std::min<std::size_t>(kMaxTerms, m - 1)); t >= 1; --t) {
     // Normal equations of e_[j] ~ sum_p a_p e_[j-1-p] over the targets j = m-w .. m-1; more equations than terms,
@@ -69,7 +69,7 @@ ErrorRecurrence::Fit ErrorRecurrence::fit(const Gram& G, std::size_t m, std::siz
   return {};
 }
 
-ErrorRecurrence::Fit ErrorRecurrence::next_fit(const Gram& G, std::size_t unknowns) const {
+GuessErrorPredictor::Fit GuessErrorPredictor::next_fit(const Gram& G, std::size_t unknowns) const {
   const std::size_t m = e_.size();
   if (m >= 3) {  // did the fit one step earlier, applied to e_[m-2], e_[m-3], ..., predict e_[m-1]?
     if (const Fit last = fit(G, m - 1, unknowns); last.terms > 0) {
@@ -85,15 +85,15 @@ ErrorRecurrence::Fit ErrorRecurrence::next_fit(const Gram& G, std::size_t unknow
   return fit(G, m, unknowns);
 }
 
-std::vector<std::size_t> ErrorRecurrence::blocks(std::span<const std::size_t> offsets) const {
+std::vector<std::size_t> GuessErrorPredictor::blocks(std::span<const std::size_t> offsets) const {
   const std::size_t n = e_.empty() ? 0 : e_.back().size();
   if (offsets.empty()) return {0, n};
   if (offsets.front() != 0 || offsets.back() != n || !std::ranges::is_sorted(offsets))
-    throw std::logic_error("ErrorRecurrence: the block offsets do not split the unknowns");
+    throw std::logic_error("GuessErrorPredictor: the block offsets do not split the unknowns");
   return {offsets.begin(), offsets.end()};
 }
 
-int ErrorRecurrence::terms(double dt, std::span<const std::size_t> offsets) const {
+int GuessErrorPredictor::terms(double dt, std::span<const std::size_t> offsets) const {
   if (dt != dt_ || e_.empty()) return 0;
   const auto b = blocks(offsets);
   update_grams(b);
@@ -102,9 +102,9 @@ int ErrorRecurrence::terms(double dt, std::span<const std::size_t> offsets) cons
   return most;
 }
 
-void ErrorRecurrence::predict(double dt, std::span<double> X, std::span<const std::size_t> offsets) const {
+void GuessErrorPredictor::predict(double dt, std::span<double> X, std::span<const std::size_t> offsets) const {
   if (dt != dt_ || e_.empty()) return;
-  if (X.size() != e_.back().size()) throw std::logic_error("ErrorRecurrence: the number of unknowns changed");
+  if (X.size() != e_.back().size()) throw std::logic_error("GuessErrorPredictor: the number of unknowns changed");
   const auto b = blocks(offsets);
   update_grams(b);
   const std::size_t m = e_.size(), nblocks = b.size() - 1;
@@ -117,7 +117,7 @@ void ErrorRecurrence::predict(double dt, std::span<double> X, std::span<const st
   }
 }
 
-void ErrorRecurrence::record(double dt, std::span<const double> error) {
+void GuessErrorPredictor::record(double dt, std::span<const double> error) {
   if (dt != dt_ || (!e_.empty() && e_.back().size() != error.size())) clear();
   dt_ = dt;
   std::vector<double> v;
@@ -134,19 +134,19 @@ void ErrorRecurrence::record(double dt, std::span<const double> error) {
   e_.push_back(std::move(v));
 }
 
-void ErrorRecurrence::clear() {
+void GuessErrorPredictor::clear() {
   e_.clear();
   dt_ = 0;
   gram_rows_ = 0;
 }
 
-std::vector<double> ErrorRecurrence::errors() const {
+std::vector<double> GuessErrorPredictor::errors() const {
   std::vector<double> out;
   for (const auto& v : e_) out.insert(out.end(), v.begin(), v.end());
   return out;
 }
 
-void ErrorRecurrence::restore(std::span<const double> errors, std::size_t n, double dt) {
+void GuessErrorPredictor::restore(std::span<const double> errors, std::size_t n, double dt) {
   if (!errors.empty() && (n == 0 || errors.size() % n != 0 || errors.size() / n > kDepth))
     throw InputError("checkpoint: integrator.guess_errors holds " + std::to_string(errors.size()) +
                      " values, not up to " + std::to_string(kDepth) + " vectors of " + std::to_string(n));

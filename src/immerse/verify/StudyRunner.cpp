@@ -1,4 +1,4 @@
-#include "immerse/verify/Runner.hpp"
+#include "immerse/verify/StudyRunner.hpp"
 
 #include <chrono>
 #include <iomanip>

@@ -20,7 +20,7 @@
 // stored errors, whether or not it was used) would have missed e^n by more than e^n itself (the recurrence stopped
 // holding: the extrapolation alone was better). The history is dropped when dt changes (the errors scale with it).
 // Measured on §4.4 (docs/time-integration.md).
-// Verified by the tests ErrorRecurrence.* (known recurrences predicted exactly, the history rules, fewer fluid
+// Verified by the tests GuessErrorPredictor.* (known recurrences predicted exactly, the history rules, fewer fluid
 // solves for the same JFNK steps).
 #include <array>
 #include <cstddef>
@@ -30,7 +30,8 @@
 
 namespace immerse {
 
-class ErrorRecurrence {
+/// Predicts the error of the implicit step's extrapolated initial guess from the errors of the steps before.
+class GuessErrorPredictor {
  public:
   static constexpr int kMaxTerms = 5;
   static constexpr int kWindow = 2;  ///< errors each fit is fitted to

@@ -1,4 +1,4 @@
-#include "immerse/simulation/Scenario.hpp"
+#include "immerse/app/Scenario.hpp"
 
 #include <algorithm>
 #include <cctype>

@@ -1,4 +1,4 @@
-#include "immerse/simulation/StretchSweep.hpp"
+#include "immerse/app/StretchSweep.hpp"
 
 #include <algorithm>
 #include <cmath>

@@ -1,0 +1,21 @@
+#pragma once
+// The mesh files of a run, to be copied into its folder, and the configuration naming the copies
+// (mesh_membraneN.msh, mesh_membraneN_reference.msh, N the first membrane using the file), so that the folder runs
+// again as it is. A file several membranes use is copied once.
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "immerse/io/Config.hpp"
+
+namespace immerse {
+
+struct MeshCopies {
+  io::Config config;
+  std::vector<std::pair<std::string, std::string>> files;  ///< name in the run folder, content
+
+  /// Reads the mesh files of `config` (InputError if one cannot be read).
+  static MeshCopies of(const io::Config& config);
+};
+
+}  // namespace immerse

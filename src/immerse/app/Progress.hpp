@@ -1,0 +1,26 @@
+#pragma once
+// The progress of a run on the log: a bar redrawn after every step on a terminal, otherwise a line every
+// output.log_seconds (time, step, steps per second, ETA, the closest approach of a node to a wall).
+#include <chrono>
+#include <iosfwd>
+
+namespace immerse {
+
+class Simulation;
+
+class Progress {
+ public:
+  Progress(std::ostream& out, double end, double log_seconds);
+  void update(const Simulation& sim, long steps_done);
+  /// Ends the bar's line (on a terminal).
+  void finish();
+
+ private:
+  using clock = std::chrono::steady_clock;
+  std::ostream& out_;
+  double end_, every_;
+  bool tty_;
+  clock::time_point t0_, last_;
+};
+
+}  // namespace immerse

@@ -1,0 +1,175 @@
+#include "immerse/app/RunOutput.hpp"
+
+#include <algorithm>
+#include <ostream>
+#include <string>
+
+#include "immerse/core/Error.hpp"
+#include "immerse/io/AtomicFile.hpp"
+#include "immerse/io/TomlFormat.hpp"
+
+namespace immerse {
+
+namespace {
+
+bool same_folder(const std::filesystem::path& a, const std::filesystem::path& b) {
+  std::error_code ec;
+  return std::filesystem::equivalent(a.parent_path().empty() ? "." : a.parent_path(), b, ec) && !ec;
+}
+
+// Whether the run continues the one in its folder (--restart of a checkpoint there); --overwrite would remove it.
+bool continues_in_place(const RunOptions& options) {
+  const bool in_place = !options.restart.empty() && same_folder(options.restart, options.out);
+  if (in_place && options.overwrite)
+    throw InputError("--overwrite: would remove the run that --restart " + options.restart.string() +
+                     " continues (leave out --overwrite to continue it in " + options.out.string() + ")");
+  return in_place;
+}
+
+// "KEY = VALUE (how)" for every key a scenario kind derived, the membranes' keys as membrane[i].KEY.
+std::vector<std::string> derived_values(const io::Config& config) {
+  std::vector<std::string> lines;
+  const auto add = [&](const io::Config& c, const std::string& prefix) {
+    for (const auto& k : c.schema().keys())
+      if (const std::string how = c.derivation(k.key); !how.empty())
+        lines.push_back(prefix + k.key + " = " + c.value_text(k.key) + " (" + how + ")");
+  };
+  add(config, "");
+  for (const auto& t : config.schema().table_arrays())
+    for (std::size_t i = 0; i < config.count(t.name); ++i)
+      add(config.entry(t.name, i), t.name + "[" + std::to_string(i) + "].");
+  return lines;
+}
+
+void write_frame(io::XdmfWriter& writer, const Simulation& sim, bool fluid_fields) {
+  std::vector<std::vector<Vec3>> X, U, F;
+  std::vector<std::vector<double>> tau1, tau2;
+  std::vector<io::SurfaceFrame> frames;
+  for (std::size_t m = 0; m < sim.num_membranes(); ++m) {
+    X.push_back(sim.op().membrane_positions(m));
+    U.push_back(sim.op().membrane_velocities(m));
+    F.emplace_back();
+    sim.membrane(m).compute_force(X.back(), F.back());
+    const auto strain = sim.membrane(m).node_strain(X.back());
+    tau1.emplace_back();
+    tau2.emplace_back();
+    for (const auto& s : strain) tau1.back().push_back(s.tau1), tau2.back().push_back(s.tau2);
+  }
+  for (std::size_t m = 0; m < sim.num_membranes(); ++m)
+    frames.push_back({"membrane" + std::to_string(m),
+                      X[m],
+                      sim.mesh(m).elements,
+                      {{"force", F[m]}, {"velocity", U[m]}},
+                      {{"tension_1", tau1[m]}, {"tension_2", tau2[m]}}});
+  const auto& f = sim.op().fluid_state();
+  const io::FluidFrame fluid{sim.grid(), f.u, f.p};
+  writer.write_frame(sim.time(), frames, fluid_fields ? &fluid : nullptr);
+}
+
+}  // namespace
+
+// A restart in place continues the tables after the checkpoint (a damaged table is refused before anything is
+// rewritten) and the frame series after the checkpoint's frame.
+RunOutput::RunOutput(const RunOptions& options, const Simulation& sim, const RunSettings& settings,
+                     ScenarioRun& scenario)
+    : options_(options),
+      sim_(sim),
+      settings_(settings),
+      scenario_(scenario),
+      dir_(options.out),
+      restarted_(!options.restart.empty()),
+      in_place_(continues_in_place(options)),
+      first_frame_(in_place_ && settings.fields_every > 0 ? static_cast<int>(sim.step() / settings.fields_every) + 1
+                                                          : 0),
+      folder_(dir_),
+      diagnostics_(sim.config(), sim.num_membranes(), scenario),
+      diagnostics_table_("diagnostics", diagnostics_.columns(),
+                         [this](long, double step) { return step <= double(sim_.step()); }) {
+  if (const auto found = folder_.run_files(); !found.empty() && !in_place_ && !options.overwrite) {
+    std::string names;
+    for (std::size_t i = 0; i < std::min<std::size_t>(found.size(), 3); ++i) names += (i ? ", " : "") + found[i];
+    if (found.size() > 3) names += ", ...";
+    throw InputError("--out " + dir_.string() + " holds another run (" + names + "): choose another folder, " +
+                     (restarted_ ? std::string("restart from that run's own checkpoint")
+                                 : "continue it with --restart " + checkpoint_file().string()) +
+                     ", or replace it with --overwrite");
+  }
+  tables_.push_back(&diagnostics_table_);
+  for (OutputTable* t : scenario.tables()) tables_.push_back(t);
+  if (in_place_)
+    for (OutputTable* t : tables_) t->read_kept_rows(dir_);
+}
+
+void RunOutput::create(const MeshCopies& copies, std::ostream& out) {
+  provenance_ = io::Provenance::now(
+      options_.command_line.empty() ? "immerse run " + options_.file.string() : options_.command_line,
+      sim_.op().thread_governor().policy());
+  if (restarted_)
+    provenance_.restarted_from = options_.restart.string() + " at step " + std::to_string(sim_.step()) + ", t = " +
+                                 io::format_number(sim_.time()) + (in_place_ ? " (continued)" : " (branched)");
+  folder_.keep_run_files();  // until the first files are written: a failure leaves the folder as it was
+  try {
+    frames_.emplace(dir_, first_frame_);  // a restart reads back the frames before the checkpoint first
+    frames_->set_attributes(provenance_.attributes());
+    if (options_.overwrite) folder_.remove_run_files();
+    folder_.remove_temporaries();  // of a writer that was killed
+    for (const OutputTable* t : tables_) t->write_kept_rows(dir_);
+    print_header(copies, out);
+    io::AtomicFile::write(dir_ / "config.resolved.toml", provenance_.toml_comments() + copies.config.to_toml_string());
+    for (const auto& [name, content] : copies.files) io::AtomicFile::write(dir_ / name, content);
+    for (const OutputTable* t : tables_) t->write_column_table(dir_);
+    const auto mode = in_place_ ? io::CsvWriter::Mode::Append : io::CsvWriter::Mode::Create;
+    for (OutputTable* t : tables_) t->open(dir_, mode);
+  } catch (const WriteError&) {
+    folder_.restore_kept();
+    throw;
+  }
+  folder_.drop_kept();
+}
+
+void RunOutput::print_header(const MeshCopies& copies, std::ostream& out) const {
+  out << "# immerse " << provenance_.version << " (commit " << provenance_.commit << "): " << options_.file.string()
+      << " -> " << dir_.string() << "\n";
+  for (const auto& line : derived_values(copies.config)) out << "# derived: " << line << "\n";
+  if (!sim_.packing_summary().empty()) out << "# " << sim_.packing_summary() << "\n";
+  if (options_.verbose)
+    out << "# resolved configuration (saved as config.resolved.toml)\n" << copies.config.to_toml_string();
+  out << std::flush;
+}
+
+// The restart step's row, frame and checkpoint exist (continued in place) or are not needed (branched).
+std::vector<Callback> RunOutput::callbacks(const StepRecord& last) {
+  std::vector<Callback> callbacks{diagnostics_callback(last), fields_callback(), checkpoint_callback()};
+  for (auto& c : callbacks)
+    if (restarted_ && (in_place_ || !c.at_start)) c.last_step = sim_.step();
+  return callbacks;
+}
+
+// A row needs the record of its step: the step that turned out unstable has none.
+Callback RunOutput::diagnostics_callback(const StepRecord& last) {
+  return {"diagnostics", settings_.diagnostics_every, !in_place_, true, [this, &last](const Simulation& s) {
+            if (last.step == s.step()) diagnostics_table_.row(diagnostics_.row(s, last));
+          }};
+}
+
+Callback RunOutput::fields_callback() {
+  const bool on = settings_.fields_every > 0;
+  return {"fields", settings_.fields_every, !in_place_ && on, on,
+          [this](const Simulation& s) { write_frame(*frames_, s, settings_.fluid_fields); }};
+}
+
+Callback RunOutput::checkpoint_callback() {
+  return {"checkpoint", settings_.checkpoint_every, false, true, [this](const Simulation& s) {
+            io::Checkpoint ck = s.checkpoint();
+            scenario_.save(ck);
+            ck.set_attributes(provenance_.attributes());
+            ck.write(checkpoint_file());
+            checkpoint_step_ = s.step();
+          }};
+}
+
+void RunOutput::discard() const {
+  if (!in_place_) folder_.remove_run_files();
+}
+
+}  // namespace immerse

@@ -1,0 +1,68 @@
+#pragma once
+// The output of `immerse run`: its folder (locked; another run's is refused unless continued or replaced), the first
+// files, and the callbacks that write diagnostics rows, ParaView frames and checkpoints on their schedules. A restart
+// into another folder branches the run: a new series that begins at the checkpoint's step.
+#include <filesystem>
+#include <iosfwd>
+#include <optional>
+#include <vector>
+
+#include "immerse/app/Callback.hpp"
+#include "immerse/app/Diagnostics.hpp"
+#include "immerse/app/MeshCopies.hpp"
+#include "immerse/app/OutputTable.hpp"
+#include "immerse/app/RunOptions.hpp"
+#include "immerse/app/RunSettings.hpp"
+#include "immerse/app/ScenarioRun.hpp"
+#include "immerse/io/OutputFolder.hpp"
+#include "immerse/io/Provenance.hpp"
+#include "immerse/io/XdmfWriter.hpp"
+#include "immerse/simulation/Simulation.hpp"
+
+namespace immerse {
+
+class RunOutput {
+ public:
+  /// Checks the folder and, when the run continues in it, reads the rows of its tables to keep (InputError on a
+  /// folder the run may not take or a damaged table). Writes nothing.
+  RunOutput(const RunOptions& options, const Simulation& sim, const RunSettings& settings, ScenarioRun& scenario);
+  RunOutput(const RunOutput&) = delete;
+  RunOutput& operator=(const RunOutput&) = delete;
+
+  /// Writes the first files, opens the tables and the frame series, and prints the run's header on `out`. If a
+  /// file cannot be written, a folder this run created is removed again and an existing one is put back as it was.
+  void create(const MeshCopies& copies, std::ostream& out);
+
+  /// The output callbacks; `last` is the record of the last accepted step, which a diagnostics row reports.
+  std::vector<Callback> callbacks(const StepRecord& last);
+
+  /// Removes this run's files after bad input found only once the run was on; a run continued in its folder keeps
+  /// them.
+  void discard() const;
+  std::filesystem::path checkpoint_file() const { return dir_ / "checkpoint.h5"; }
+  /// The step of the last checkpoint this run wrote (-1: none).
+  long last_checkpoint_step() const { return checkpoint_step_; }
+
+ private:
+  Callback diagnostics_callback(const StepRecord& last);
+  Callback fields_callback();
+  Callback checkpoint_callback();
+  void print_header(const MeshCopies& copies, std::ostream& out) const;
+
+  const RunOptions& options_;
+  const Simulation& sim_;
+  const RunSettings& settings_;
+  ScenarioRun& scenario_;
+  std::filesystem::path dir_;
+  bool restarted_, in_place_;
+  int first_frame_ = 0;
+  io::OutputFolder folder_;
+  Diagnostics diagnostics_;
+  OutputTable diagnostics_table_;
+  std::vector<OutputTable*> tables_;  ///< diagnostics.csv first, then the scenario's
+  io::Provenance provenance_;  ///< from create() on
+  std::optional<io::XdmfWriter> frames_;
+  long checkpoint_step_ = -1;
+};
+
+}  // namespace immerse

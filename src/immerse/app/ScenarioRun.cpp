@@ -1,0 +1,15 @@
+#include "immerse/app/ScenarioRun.hpp"
+
+#include "immerse/app/ChannelRun.hpp"
+#include "immerse/app/StretchSweepRun.hpp"
+
+namespace immerse {
+
+std::unique_ptr<ScenarioRun> make_scenario_run(const io::Config& config) {
+  const std::string kind = config.get<std::string>("scenario.kind");
+  if (kind == "rbc_stretch") return std::make_unique<StretchSweepRun>();
+  if (kind == "rbc_channel") return std::make_unique<ChannelRun>();
+  return std::make_unique<ScenarioRun>();
+}
+
+}  // namespace immerse

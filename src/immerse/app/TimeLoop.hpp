@@ -1,0 +1,55 @@
+#pragma once
+// The time loop of `immerse run`: steps until time.end, the scenario's end or a stop signal, with the scenario's work
+// and the output callbacks after each step, and turns what ended the run into its exit status. The last state is
+// always saved (after an instability: the unstable state, for inspection), unless writing is what failed.
+#include <iosfwd>
+#include <string>
+#include <vector>
+
+#include "immerse/app/Callback.hpp"
+#include "immerse/app/Progress.hpp"
+#include "immerse/app/RunOutput.hpp"
+#include "immerse/app/RunSettings.hpp"
+#include "immerse/app/ScenarioRun.hpp"
+#include "immerse/core/Error.hpp"
+#include "immerse/simulation/Simulation.hpp"
+#include "immerse/simulation/StepTimings.hpp"
+
+namespace immerse {
+
+class TimeLoop {
+ public:
+  TimeLoop(Simulation& sim, ScenarioRun& scenario, RunOutput& output, const RunSettings& settings, std::ostream& out,
+           std::ostream& err);
+  TimeLoop(const TimeLoop&) = delete;
+  TimeLoop& operator=(const TimeLoop&) = delete;
+
+  /// Runs the loop; returns the exit status of run_command (0, 3, 4 or 5). Bad input found only once the run is on
+  /// (InputError) removes the run's files (RunOutput::discard) and passes through.
+  int run();
+
+  /// Steps taken, the wall time spent in Simulation::advance (failed calls included), and its parts.
+  long steps() const { return steps_; }
+  double stepping_seconds() const { return stepping_; }
+  StepTimings timings() const { return sim_.op().timings().since(timings_at_start_); }
+
+ private:
+  void step_once();
+  void log(const std::string& message);
+  void write_failed(const WriteError& e);
+
+  Simulation& sim_;
+  ScenarioRun& scenario_;
+  RunOutput& output_;
+  std::ostream& out_;
+  std::ostream& err_;
+  StepRecord last_;  ///< of the last accepted step (the diagnostics rows report it)
+  std::vector<Callback> callbacks_;
+  Progress progress_;
+  int status_ = 0;
+  long steps_ = 0;
+  double stepping_ = 0;
+  StepTimings timings_at_start_;
+};
+
+}  // namespace immerse
