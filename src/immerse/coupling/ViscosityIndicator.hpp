@@ -12,7 +12,8 @@
 // [min(0, λ_m − 1), max(0, λ_m − 1)] over the membranes, and values below kFloor · max_m |λ_m − 1| in magnitude (the
 // discretization error of the far field) are set to zero, so that χ vanishes exactly away from the membranes.
 // Bitwise independent of the thread count (the spreading is; the sums are serial).
-// Verified by: the tests ViscosityIndicator.* (a sphere: χ inside, outside, its integral; λ < 1; two membranes).
+// Verified by: the test ViscosityContrast.IndicatorOfASphereIsTheContrastInsideAndZeroOutside (a sphere, λ = 5 and
+// 0.2: χ inside, outside and its integral) and the capsule of ViscosityContrastShear.*.
 #include <array>
 #include <memory>
 #include <span>

@@ -19,7 +19,8 @@
 // the residual g(X) of an implicit step then holds the viscosity of its own midpoint.
 // All membranes' nodes are concatenated in one array; errors name the membrane and its local node or element.
 // Verified by the tests ImmersedBoundaryOperator.* (thread independence, what trials take over and reuse, failing
-// membrane named) and the studies oscillating_time_order and oscillating_stability, which step through it.
+// membrane named), Reproducibility/ViscosityContrast.* (a viscosity contrast across thread counts and a restart) and
+// the studies oscillating_time_order and oscillating_stability, which step through it.
 #include <algorithm>
 #include <memory>
 #include <optional>
