@@ -47,7 +47,8 @@
 // (μ_p − μ)∇²(u^{n+1} − 2u^n + u^{n−1})/2 = O(Δt²)); stable in the Stokes limit for μ_p ≥ max μ(x).
 // Verified by: the studies fluid_divergence, taylor_green, abc_flow, couette, duct_poiseuille, closed_box_mms and the
 // tests NavierStokesSolver.*, CompareRuns.TimeStepErrorInTheStokesRegimeIsSecondOrderWithTheExtrapolatedPressure,
-// ViscosityContrast.ManufacturedFlowIsSecondOrderInSpaceAndTime.
+// ViscosityContrast.ManufacturedFlowIsSecondOrderInSpaceAndTime, ViscosityContrast.ManufacturedFlowInAClosedBox*,
+// ViscosityContrast.UnforcedFlowDecaysInTheStokesLimitWhenTheImplicitViscosityIsTheLargest.
 #include <array>
 #include <cstdint>
 #include <memory>

@@ -10,8 +10,8 @@
 // It reads the velocity at faces and χ at cells one index either side of the face (wrapped on periodic axes, and
 // never across a wall: callers apply it only where every index read is stored, i.e. where χ vanishes within three
 // cells of every wall). For constant χ and D_h u = 0 it equals χ ∇_h² u (the Laplacian of MacStencil_K.hpp).
-// Verified by: the tests ViscosityContrast.StressOfConstantViscosityIsTheLaplacian and
-// ViscosityContrast.ManufacturedFlowIsSecondOrderInSpaceAndTime.
+// Verified by: the tests ViscosityContrast.StressOfConstantViscosityIsTheLaplacian,
+// ViscosityContrast.ManufacturedFlowIsSecondOrderInSpaceAndTime and ViscosityContrast.ManufacturedFlowInAClosedBox*.
 #include "immerse/core/Array3.hpp"
 #include "immerse/fluid/MacGeom.hpp"
 #include "immerse/fluid/MacStencil_K.hpp"
