@@ -133,8 +133,7 @@ Vec3 bump_stress(const ClosedBoxMms& m, const Vec3& x) {
 }
 
 /// The closed box (six no-slip walls) with μ = μ0 (1 + χ), χ the bump: the max error of u and the L2 error of p
-/// after T = 0.25 with
-/// Δt = 0.2 h, from the exact u(0), p(−Δt/2) and history.
+/// after T = 0.25 with Δt = 0.2 h, from the exact u(0), p(−Δt/2) and history.
 std::pair<double, double> closed_box_errors(int n) {
   const ClosedBoxMms mms{1.0, 0.1};
   const Grid grid({n, n, n}, {1.0, 1.0, 1.0}, {W, W, W});

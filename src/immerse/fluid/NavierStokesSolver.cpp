@@ -415,24 +415,24 @@ void NavierStokesSolver::prepare_variable(const FluidState& in, double dt, Prepa
   ensure_shape(prepared.utilde_, grid_);
   const bool extrapolate = !first_step(in) && matches_grid(in.u_prev);
   const double half_r = extrapolate ? 0.5 * dt / in.dt_prev : 0.0;
+  const double dmu = mu_implicit_ - params_.mu;
   for (int d = 0; d < 3; ++d) {
     const long n = static_cast<long>(in.u[d].size());
     const double* const u = in.u[d].data();
     const double* const up = extrapolate ? in.u_prev[d].data() : u;
     double* const ut = prepared.utilde_[d].data();
+    if (dmu != 0) {
+      // (μ_p − μ) ∇_h²(u^n/2 − ũ) with homogeneous walls, from u^n/2 − ũ held in utilde_ meanwhile.
+#pragma omp parallel for schedule(static) if (geom_.threaded())
+      for (long i = 0; i < n; ++i) ut[i] = 0.5 * u[i] - (u[i] + half_r * (u[i] - up[i]));
+      Array3& e = prepared.explicit_[d];
+      const Array3& w = prepared.utilde_[d];
+      for_each_face(geom_, d, [&](int i, int j, int k) {
+        e(i, j, k) += dmu * mac::laplacian_face(w, geom0_, d, mac::Index{i, j, k});
+      });
+    }
 #pragma omp parallel for schedule(static) if (geom_.threaded())
     for (long i = 0; i < n; ++i) ut[i] = u[i] + half_r * (u[i] - up[i]);
-  }
-  const double dmu = mu_implicit_ - params_.mu;
-  if (dmu == 0) return;
-  for (int d = 0; d < 3; ++d) {
-    Array3& e = prepared.explicit_[d];
-    const Array3& un = in.u[d];
-    const Array3& ut = prepared.utilde_[d];
-    for_each_face(geom_, d, [&](int i, int j, int k) {
-      const mac::Index q{i, j, k};
-      e(i, j, k) += dmu * (0.5 * mac::laplacian_face(un, geom0_, d, q) - mac::laplacian_face(ut, geom0_, d, q));
-    });
   }
 }
 
