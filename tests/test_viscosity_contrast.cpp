@@ -11,6 +11,7 @@
 #include <utility>
 #include <vector>
 
+#include "immerse/core/Error.hpp"
 #include "immerse/coupling/IBCoupler.hpp"
 #include "immerse/coupling/ViscosityIndicator.hpp"
 #include "immerse/fluid/ExactSolutions.hpp"
@@ -210,6 +211,22 @@ TEST(ViscosityContrast, ManufacturedFlowInAClosedBoxIsSecondOrderInSpace) {
   RecordProperty("order_p", std::to_string(order_p));
   EXPECT_GE(order_u, 1.9);
   EXPECT_GE(order_p, 1.9);
+}
+
+TEST(ViscosityContrast, ViscosityWithinThreeCellsOfAWallIsRefused) {
+  const Grid grid({12, 12, 12}, {1.0, 1.0, 1.0}, {P, P, W});
+  FluidParams prm;
+  prm.variable_viscosity = true;
+  prm.implicit_ratio = 2;
+  NavierStokesSolver ns(grid, prm, FftPlanning::Estimate);
+  const FluidState a = ns.initial_state();
+  FluidState b;
+  const FaceField zero(grid);
+  Array3 chi(12, 12, 12);
+  chi(5, 5, 3) = 1;  // the fourth cell from the wall z = 0: allowed
+  EXPECT_NO_THROW(ns.step(a, zero, 0.01, b, &chi));
+  chi(5, 5, 9) = 1;  // the third from z = 1
+  EXPECT_THROW(ns.step(a, zero, 0.01, b, &chi), SimulationError);
 }
 
 TEST(ViscosityContrast, StressOfConstantViscosityIsTheLaplacian) {
