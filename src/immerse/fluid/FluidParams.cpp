@@ -11,6 +11,7 @@ void FluidParams::validate(const Grid& grid) const {
   static const char* axis[3] = {"x", "y", "z"};
   require(std::isfinite(rho) && rho > 0, "fluid.rho", rho, "> 0");
   require(std::isfinite(mu) && mu > 0, "fluid.mu", mu, "> 0");
+  require(std::isfinite(implicit_ratio) && implicit_ratio >= 1, "implicit viscosity ratio", implicit_ratio, ">= 1");
   for (int d = 0; d < 3; ++d)
     require(std::isfinite(body_force[d]), std::string("fluid.body_force.") + axis[d], body_force[d], "finite");
   for (int a = 0; a < 3; ++a) {

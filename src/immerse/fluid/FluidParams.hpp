@@ -23,10 +23,15 @@ struct FluidParams {
   std::array<Vec3, 3> wall_lower{};
   std::array<Vec3, 3> wall_upper{};
   PressurePredictor pressure = PressurePredictor::Lagged;
+  /// Viscosity contrast (NavierStokesSolver.hpp, docs/viscosity-contrast.md): μ(x) = mu (1 + χ(x)) with χ given to
+  /// each step, and the implicit part of (9) taken with mu_implicit = implicit_ratio · mu ≥ max μ(x). Off: the
+  /// constant-viscosity step of the paper.
+  bool variable_viscosity = false;
+  double implicit_ratio = 1.0;
 
   /// Throws a one-line InputError unless rho, mu > 0 and finite, the body force and wall velocities are finite,
   /// and on every wall axis the normal wall velocity is the same at both walls (zero net flux through the
-  /// boundary: the pressure Neumann problem (11) is then solvable).
+  /// boundary: the pressure Neumann problem (11) is then solvable), and implicit_ratio ≥ 1 and finite.
   void validate(const Grid& grid) const;
 };
 

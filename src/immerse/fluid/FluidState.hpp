@@ -11,6 +11,7 @@ struct FluidState {
   FaceField u;         ///< velocity u^n on the MAC faces (wall faces hold the normal wall velocity)
   Array3 p;            ///< pressure p^{n-1/2} at the cell centres (a half step behind u)
   Array3 p_prev;       ///< the pressure before it, p^{n-3/2} (a step's pressure only when dt_prev2 > 0)
+  FaceField u_prev;    ///< u^{n-1}, kept only with a variable viscosity (its explicit part is extrapolated); else empty
   FaceField adv;       ///< advection term (u·∇_h u)^{n-1} of the previous step, for Adams–Bashforth (10)
   double dt_prev = 0;  ///< time step that produced u^n (0 before the first step)
   double dt_prev2 = 0; ///< the step before it, which produced p^{n-3/2} (0 before the second step)

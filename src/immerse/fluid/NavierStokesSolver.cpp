@@ -8,6 +8,7 @@
 
 #include "immerse/core/Error.hpp"
 #include "immerse/fluid/MacStencil_K.hpp"
+#include "immerse/fluid/ViscousStress_K.hpp"
 
 namespace immerse {
 
@@ -224,6 +225,8 @@ NavierStokesSolver::NavierStokesSolver(const Grid& grid, const FluidParams& para
     : grid_(grid),
       params_(params),
       geom_(grid, params),
+      geom0_(grid),
+      mu_implicit_(params.variable_viscosity ? params.implicit_ratio * params.mu : params.mu),
       ustar_(grid),
       div_(grid.n(0), grid.n(1), grid.n(2)),
       phi_(grid.n(0), grid.n(1), grid.n(2)) {
@@ -297,7 +300,7 @@ void NavierStokesSolver::advance(const FluidState& in, double dt, const Array3& 
   ensure_shape(out.p_prev, grid_);
 
   const MacGeom& g = geom_;
-  const double rho = params_.rho, mu = params_.mu;
+  const double rho = params_.rho, mu = mu_implicit_;
   const double c = mu * dt / (2.0 * rho);  // (I − c ∇_h²) u* = rhs
   const double dt_rho = dt / rho;
 
@@ -326,6 +329,10 @@ void NavierStokesSolver::advance(const FluidState& in, double dt, const Array3& 
       project_and_update_row<mac::Strided>(g, ustar_, phi_, div_, p, in.p, out, j, k, dt_rho, half_mu);
   });
   apply_wall_values(out.u);
+  if (params_.variable_viscosity) {
+    ensure_shape(out.u_prev, grid_);
+    for (int d = 0; d < 3; ++d) out.u_prev[d].values() = in.u[d].values();
+  }
 
   out.dt_prev2 = in.dt_prev;
   out.dt_prev = dt;
@@ -333,7 +340,13 @@ void NavierStokesSolver::advance(const FluidState& in, double dt, const Array3& 
   out.time = in.time + dt;
 }
 
-void NavierStokesSolver::step(const FluidState& in, const FaceField& force, double dt, FluidState& out) {
+void NavierStokesSolver::step(const FluidState& in, const FaceField& force, double dt, FluidState& out,
+                              const Array3* chi) {
+  if (params_.variable_viscosity) {
+    prepare(in, dt, own_);
+    step(own_, force, out, chi);
+    return;
+  }
   check(in, dt);
   check_force(force);
   if (&in == &out) throw std::invalid_argument("NavierStokesSolver::step: `in` and `out` must be different states");
@@ -355,6 +368,7 @@ void NavierStokesSolver::prepare(const FluidState& in, double dt, PreparedStep& 
   for (int d = 0; d < 3; ++d)
     build<false>(geom_, d, in, p, nullptr, rhs_coefficients(params_, in, dt, d), prepared.adv_[d],
                  prepared.explicit_[d]);
+  if (params_.variable_viscosity) prepare_variable(in, dt, prepared);
   static std::atomic<std::uint64_t> prepares{0};  // (ids only: results never depend on it)
   prepared.state_ = &in;
   prepared.id_ = ++prepares;
@@ -363,7 +377,8 @@ void NavierStokesSolver::prepare(const FluidState& in, double dt, PreparedStep& 
   prepared.dt_ = dt;
 }
 
-void NavierStokesSolver::step(const PreparedStep& prepared, const FaceField& force, FluidState& out) {
+void NavierStokesSolver::step(const PreparedStep& prepared, const FaceField& force, FluidState& out,
+                              const Array3* chi) {
   const FluidState* const in = prepared.state_;
   if (!in) throw std::invalid_argument("NavierStokesSolver::step: the step was not prepared");
   if (!prepared.prepared_for(*in, prepared.dt_))
@@ -373,6 +388,10 @@ void NavierStokesSolver::step(const PreparedStep& prepared, const FaceField& for
   check_force(force);
   const double dt = prepared.dt_;
   // (9) from the prepared explicit terms; their (u·∇_h u)^n into the new state unless it holds it already.
+  const bool stress = params_.variable_viscosity && chi;
+  if (stress && chi->shape() != grid_.cell_shape())
+    throw std::invalid_argument("NavierStokesSolver::step: the viscosity field does not match the grid");
+  const IndexBox box = stress ? variable_stress_box(*chi) : IndexBox{};
   const bool copy_adv = out.adv_of != prepared.id_ || !matches_grid(out.adv);
   out.adv_of = 0;
   const auto rhs = [&]<bool CopyAdv>(int d) {
@@ -387,8 +406,81 @@ void NavierStokesSolver::step(const PreparedStep& prepared, const FaceField& for
       rhs.template operator()<true>(d);
     else
       rhs.template operator()<false>(d);
+    if (stress) add_variable_stress(prepared.utilde_, *chi, dt, d, box);
   });
   out.adv_of = prepared.id_;
+}
+
+void NavierStokesSolver::prepare_variable(const FluidState& in, double dt, PreparedStep& prepared) const {
+  ensure_shape(prepared.utilde_, grid_);
+  const bool extrapolate = !first_step(in) && matches_grid(in.u_prev);
+  const double half_r = extrapolate ? 0.5 * dt / in.dt_prev : 0.0;
+  const double dmu = mu_implicit_ - params_.mu;
+  for (int d = 0; d < 3; ++d) {
+    const long n = static_cast<long>(in.u[d].size());
+    const double* const u = in.u[d].data();
+    const double* const up = extrapolate ? in.u_prev[d].data() : u;
+    double* const ut = prepared.utilde_[d].data();
+    if (dmu != 0) {
+      // (μ_p − μ) ∇_h²(u^n/2 − ũ) with homogeneous walls, from u^n/2 − ũ held in utilde_ meanwhile.
+#pragma omp parallel for schedule(static) if (geom_.threaded())
+      for (long i = 0; i < n; ++i) ut[i] = 0.5 * u[i] - (u[i] + half_r * (u[i] - up[i]));
+      Array3& e = prepared.explicit_[d];
+      const Array3& w = prepared.utilde_[d];
+      for_each_face(geom_, d, [&](int i, int j, int k) {
+        e(i, j, k) += dmu * mac::laplacian_face(w, geom0_, d, mac::Index{i, j, k});
+      });
+    }
+#pragma omp parallel for schedule(static) if (geom_.threaded())
+    for (long i = 0; i < n; ++i) ut[i] = u[i] + half_r * (u[i] - up[i]);
+  }
+}
+
+IndexBox NavierStokesSolver::variable_stress_box(const Array3& chi) const {
+  const MacGeom& g = geom_;
+  std::array<int, 3> lo = g.n, hi{-1, -1, -1};
+  for (int k = 0; k < g.n[2]; ++k)
+    for (int j = 0; j < g.n[1]; ++j) {
+      const double* const row = chi.data() + chi.index(0, j, k);
+      for (int i = 0; i < g.n[0]; ++i)
+        if (row[i] != 0.0) {
+          const std::array<int, 3> q{i, j, k};
+          for (int a = 0; a < 3; ++a) {
+            lo[a] = std::min(lo[a], q[a]);
+            hi[a] = std::max(hi[a], q[a]);
+          }
+        }
+    }
+  if (hi[0] < 0) return IndexBox{{0, 0, 0}, {0, 0, 0}};
+  IndexBox box{};
+  for (int a = 0; a < 3; ++a) {
+    if (!g.periodic[a] && (lo[a] < 3 || hi[a] > g.n[a] - 4))
+      throw SimulationError(
+          "viscosity contrast: the interior of a membrane with viscosity_ratio != 1 reaches within three cells of a "
+          "wall (its indicator must vanish there)");
+    if (g.periodic[a] && (lo[a] < 1 || hi[a] > g.n[a] - 2)) {
+      box.begin[a] = 0;
+      box.end[a] = g.n[a];
+    } else {
+      box.begin[a] = lo[a] - 1;
+      box.end[a] = hi[a] + 2;
+    }
+  }
+  return box;
+}
+
+void NavierStokesSolver::add_variable_stress(const FaceField& utilde, const Array3& chi, double dt, int d,
+                                             const IndexBox& box) {
+  const MacGeom& g = geom_;
+  const double c = dt / params_.rho * params_.mu;
+  Array3& rhs = ustar_[d];
+  const int i0 = std::max(box.begin[0], g.first(d, 0)), j0 = std::max(box.begin[1], g.first(d, 1)),
+            k0 = std::max(box.begin[2], g.first(d, 2));
+#pragma omp parallel for collapse(2) schedule(static) if (g.threaded())
+  for (int k = k0; k < box.end[2]; ++k)
+    for (int j = j0; j < box.end[1]; ++j)
+      for (int i = i0; i < box.end[0]; ++i)
+        rhs(i, j, k) += c * mac::stress_divergence(utilde, chi, g, d, mac::Index{i, j, k});
 }
 
 }  // namespace immerse

@@ -31,8 +31,24 @@
 // step are fluid steps from the same state with the same Δt under different forces: they share one prepare().
 // Both paths evaluate the same pointwise functions, the sums of u^n + (Δt/ρ)(−ρ A − G p + (μ/2) ∇_h² u^n + F +
 // f_body) taken left to right, so the split step is bitwise the one-pass one.
+//
+// Variable viscosity (FluidParams::variable_viscosity; docs/viscosity-contrast.md). With μ(x) = μ (1 + χ(x)) the
+// viscous term of (9) is ½[∇_h·(μ(∇_h u* + ∇_h u*ᵀ)) + ∇_h·(μ(∇_h u^n + ∇_h u^nᵀ))]. The fast solvers invert only
+// the constant part: with μ_p = implicit_ratio · μ ≥ max μ(x) and L_μ the stress operator, (9) takes
+//   ½ L_μ(u* + u^n) ≈ (μ_p/2) ∇_h²(u* + u^n) + (L_μ − μ_p ∇_h²) ũ,  ũ = u^n + (r/2)(u^n − u^{n−1}),  r = Δt/Δt_prev
+// (ũ = u^n on the first step), the remainder at the extrapolated midpoint velocity: a Douglas–Dupont-type
+// stabilization, as in Fai, Griffith, Mori & Peskin (2013, SIAM J. Sci. Comput. 35). With D_h ũ = 0,
+// L_μ ũ = μ ∇_h² ũ + μ ∇_h·(χ(∇_h ũ + ∇_h ũᵀ)) (ViscousStress_K.hpp): the first part carries the wall values, the
+// second vanishes where χ does, which must hold within three cells of every wall (SimulationError otherwise).
+// prepare() adds (μ_p − μ) ∇_h²(u^n/2 − ũ) (homogeneous walls) to E; step(prepared, F, out, χ) adds μ ∇_h·(χ S(ũ)).
+// (I − (μ_p Δt/2ρ) ∇_h²) is what is inverted, so (13) takes μ_p: p^{n+1/2} = p̃ + φ − (μ_p/2) D u* makes the step's
+// u^{n+1} satisfy (9) with G p^{n+1/2} exactly, as (13) does for a constant μ. Without variable viscosity
+// μ_p = μ and the step is bitwise the constant-viscosity one. Second order in Δt (the remainder's error is
+// (μ_p − μ)∇²(u^{n+1} − 2u^n + u^{n−1})/2 = O(Δt²)); stable in the Stokes limit for μ_p ≥ max μ(x).
 // Verified by: the studies fluid_divergence, taylor_green, abc_flow, couette, duct_poiseuille, closed_box_mms and the
-// tests NavierStokesSolver.*, CompareRuns.TimeStepErrorInTheStokesRegimeIsSecondOrderWithTheExtrapolatedPressure.
+// tests NavierStokesSolver.*, CompareRuns.TimeStepErrorInTheStokesRegimeIsSecondOrderWithTheExtrapolatedPressure,
+// ViscosityContrast.ManufacturedFlowIsSecondOrderInSpaceAndTime, ViscosityContrast.ManufacturedFlowInAClosedBox*,
+// ViscosityContrast.UnforcedFlowDecaysInTheStokesLimitWhenTheImplicitViscosityIsTheLargest.
 #include <array>
 #include <cstdint>
 #include <memory>
@@ -63,6 +79,7 @@ class PreparedStep {
   FaceField adv_;                      ///< (u·∇_h u)^n at the unknowns: the adv of the next state
   FaceField explicit_;  ///< E = −ρ A^{n+1/2} − G p^{n−1/2} + (μ/2) ∇_h² u^n (wall sources included) at the unknowns
   Array3 pressure_;     ///< p̃ of (9) and (13), when extrapolated_
+  FaceField utilde_;    ///< ũ, with a variable viscosity
   bool extrapolated_ = false;  ///< whether (9) takes pressure_ (FluidParams::pressure), else p^{n−1/2}
   double dt_ = 0;       ///< Δt
   long step_ = 0;       ///< step and time of the state when prepared
@@ -91,7 +108,8 @@ class NavierStokesSolver {
   /// velocity faces; its wall faces are ignored). Pure: `in` is only read; `out` must be a different object
   /// (it is sized on first use, then reused without allocation). Not reentrant: uses internal work arrays.
   /// Bitwise the same as prepare(in, dt, p) then step(p, force, out), in one pass over the faces for (9).
-  void step(const FluidState& in, const FaceField& force, double dt, FluidState& out);
+  /// With a variable viscosity, chi is χ at the cells (null: χ = 0), the viscosity μ (1 + χ) of this step.
+  void step(const FluidState& in, const FaceField& force, double dt, FluidState& out, const Array3* chi = nullptr);
 
   /// Computes into `prepared` the part of the step of size dt after `in` that does not depend on the force: A^{n+1/2}
   /// by (10) and the explicit terms of (9) (`prepared` is sized on first use, then reused without allocation).
@@ -104,7 +122,8 @@ class NavierStokesSolver {
   /// step counter and time of prepare() (std::logic_error otherwise). (u·∇_h u)^n is copied into out.adv only when
   /// `out` does not hold it already from an earlier call after the same prepare() (FluidState::adv_of): the trials
   /// of an implicit step, written into one output state, copy it once. Not reentrant: uses internal work arrays.
-  void step(const PreparedStep& prepared, const FaceField& force, FluidState& out);
+  /// With a variable viscosity, chi is χ at the cells (null: χ = 0); it may differ from one force to the next.
+  void step(const PreparedStep& prepared, const FaceField& force, FluidState& out, const Array3* chi = nullptr);
 
   /// Writes the normal wall velocity into the wall faces of u (the boundary condition (3)).
   void apply_wall_values(FaceField& u) const;
@@ -126,6 +145,19 @@ class NavierStokesSolver {
   template <class Rhs>
   void advance(const FluidState& in, double dt, const Array3& p, FluidState& out, Rhs&& rhs);
 
+  /// Adds (Δt/ρ) μ ∇_h·(χ S(ũ)) to the right-hand side u* of (9) where χ is not zero (SimulationError when χ is not
+  /// zero within three cells of a wall).
+  /// Component d of it, over the box of faces where it may not vanish (variable_stress_box).
+  void add_variable_stress(const FaceField& utilde, const Array3& chi, double dt, int d, const IndexBox& box);
+  /// The faces whose stress term reads a non-zero χ (an empty box when χ = 0 everywhere); SimulationError when χ is
+  /// not zero within three cells of a wall.
+  IndexBox variable_stress_box(const Array3& chi) const;
+  /// ũ and (μ_p − μ) ∇_h²(u^n/2 − ũ) added to the explicit terms of `prepared`.
+  void prepare_variable(const FluidState& in, double dt, PreparedStep& prepared) const;
+
+  MacGeom geom0_;        // homogeneous walls: the part of ∇_h² that the remainder of a variable viscosity takes
+  double mu_implicit_;   // μ_p (μ without a variable viscosity)
+  PreparedStep own_;     // the one-pass step's preparation, with a variable viscosity
   std::array<std::unique_ptr<FastSolver>, 4> solvers_;
   FaceField ustar_;  // u*, then u^{n+1}
   Array3 div_;       // D u*

@@ -77,6 +77,8 @@ class ElasticMembrane {
 
   std::size_t num_nodes() const { return reference_.size(); }
   std::size_t num_elements() const { return elements_.size(); }
+  /// The elements' node indices (Mesh::elements).
+  const std::vector<std::array<int, 6>>& elements() const { return elements_; }
   ForceMethod method() const { return method_; }
   /// The global volume and area constraints, when a modulus is > 0.
   const std::optional<VolumeAreaConstraint>& constraint() const { return constraint_; }

@@ -64,7 +64,7 @@ void blend(const Grid& g, double theta, const FaceField& a, const FaceField& b, 
 ImmersedBoundaryOperator::ImmersedBoundaryOperator(NavierStokesSolver& fluid, IBCoupler& coupler,
                                                    std::vector<const ElasticMembrane*> membranes,
                                                    std::vector<std::vector<Vec3>> X0, FluidState fluid_state,
-                                                   const ContactSettings& contact)
+                                                   const ContactSettings& contact, std::vector<double> viscosity_ratio)
     : fluid_(fluid),
       coupler_(coupler),
       membranes_(std::move(membranes)),
@@ -90,8 +90,26 @@ ImmersedBoundaryOperator::ImmersedBoundaryOperator(NavierStokesSolver& fluid, IB
     contact_.emplace(fluid_.grid(), contact, offset_, std::move(moduli));
     contact_F_.resize(X_.size());
   }
+  if (std::ranges::any_of(viscosity_ratio, [](double r) { return r != 1.0; })) {
+    if (viscosity_ratio.size() != membranes_.size())
+      throw std::logic_error("ImmersedBoundaryOperator: one viscosity ratio per membrane");
+    if (!fluid_.params().variable_viscosity)
+      throw std::logic_error("ImmersedBoundaryOperator: a viscosity contrast needs a fluid solver with variable viscosity");
+    ratio_ = std::move(viscosity_ratio);
+    indicator_ = std::make_unique<ViscosityIndicator>(coupler_);
+    for (std::size_t m = 0; m < membranes_.size(); ++m) Xmid_.emplace_back(X0[m].size());
+  }
   membrane_force_density(X_, force_start_);
   coupler_.interpolate_velocity(committed_.u, X_, U_);
+}
+
+void ImmersedBoundaryOperator::update_indicator(std::span<const Vec3> Xf) {
+  std::vector<IndicatorSurface> surfaces;
+  for (std::size_t m = 0; m < membranes_.size(); ++m) {
+    for (std::size_t i = 0; i < Xmid_[m].size(); ++i) Xmid_[m][i] = 0.5 * (X_[offset_[m] + i] + Xf[offset_[m] + i]);
+    surfaces.push_back({&membranes_[m]->elements(), &Xmid_[m], ratio_[m]});
+  }
+  indicator_->compute(surfaces, chi_);
 }
 
 void ImmersedBoundaryOperator::nodal_force(std::size_t m, std::span<const Vec3> X) {
@@ -167,7 +185,8 @@ double ImmersedBoundaryOperator::trial_step(std::span<const double> Xf, double t
   timed(timings_.fluid, Phase::FluidStep, [&] {
     if (theta < 1.0) blend(fluid_.grid(), theta, force_, force_start_, mixed_);
     if (!prepared_.prepared_for(committed_, dt)) timed(occasional, [&] { fluid_.prepare(committed_, dt, prepared_); });
-    fluid_.step(prepared_, theta < 1.0 ? mixed_ : force_, trial_);
+    if (indicator_) update_indicator(nodes(Xf));
+    fluid_.step(prepared_, theta < 1.0 ? mixed_ : force_, trial_, indicator_ ? &chi_ : nullptr);
   });
   ++solves_;
   return occasional;

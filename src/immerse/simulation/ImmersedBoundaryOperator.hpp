@@ -4,6 +4,7 @@
 //   f(X)      membrane forces at the nodes           ElasticMembrane::compute_force  (§2.3, eq. 42 or -dE/dX)
 //             plus the contact forces                 ContactForce::compute (membrane-membrane, membrane-wall)
 //   S(X) f    spread to the MAC faces                 IBCoupler::spread_force          (eq. 6)
+//   χ(X̄)      interior indicator, viscosity contrast  ViscosityIndicator::compute      (X̄ = (X^n + Xf)/2)
 //   u^{n+1}   one projection step driven by F^{n+1/2}  NavierStokesSolver::prepare, step (eqs. 9-13)
 //   J(X) u    interpolated back to the nodes          IBCoupler::interpolate_velocity  (eq. 14)
 //
@@ -13,16 +14,22 @@
 // takes its node velocity J(X^{n+1}) u^{n+1} over when that trial was driven and interpolated at X^{n+1}. The part
 // of the fluid step that does not depend on the force is prepared once from the committed state for the trials'
 // dt, and shared by all the trials with that dt until commit().
+// With a viscosity contrast (a membrane's viscosity_ratio λ ≠ 1) every trial evaluates the indicator χ at the
+// midpoint of the committed positions and its own, X̄ = (X^n + Xf)/2, and the fluid step takes μ = μ_out (1 + χ):
+// the residual g(X) of an implicit step then holds the viscosity of its own midpoint.
 // All membranes' nodes are concatenated in one array; errors name the membrane and its local node or element.
 // Verified by the tests ImmersedBoundaryOperator.* (thread independence, what trials take over and reuse, failing
-// membrane named) and the studies oscillating_time_order and oscillating_stability, which step through it.
+// membrane named), Reproducibility/ViscosityContrast.* (a viscosity contrast across thread counts and a restart) and
+// the studies oscillating_time_order and oscillating_stability, which step through it.
 #include <algorithm>
+#include <memory>
 #include <optional>
 #include <span>
 #include <vector>
 
 #include "immerse/core/ThreadGovernor.hpp"
 #include "immerse/coupling/IBCoupler.hpp"
+#include "immerse/coupling/ViscosityIndicator.hpp"
 #include "immerse/fluid/NavierStokesSolver.hpp"
 #include "immerse/membrane/ElasticMembrane.hpp"
 #include "immerse/simulation/ContactForce.hpp"
@@ -34,10 +41,12 @@ namespace immerse {
 class ImmersedBoundaryOperator final : public CoupledOperator {
  public:
   /// `membranes` and their initial positions X0 (one array per membrane); the fluid starts from `fluid_state`;
-  /// the membranes repel each other and the walls by `contact` (off by default).
+  /// the membranes repel each other and the walls by `contact` (off by default); viscosity_ratio holds each
+  /// membrane's λ = μ_in/μ_out (empty: all 1; any λ ≠ 1 needs a fluid solver with variable viscosity).
   ImmersedBoundaryOperator(NavierStokesSolver& fluid, IBCoupler& coupler,
                            std::vector<const ElasticMembrane*> membranes, std::vector<std::vector<Vec3>> X0,
-                           FluidState fluid_state, const ContactSettings& contact = {});
+                           FluidState fluid_state, const ContactSettings& contact = {},
+                           std::vector<double> viscosity_ratio = {});
 
   std::size_t size() const override { return 3 * X_.size(); }
   std::span<const double> positions() const override { return flat(X_); }
@@ -61,6 +70,8 @@ class ImmersedBoundaryOperator final : public CoupledOperator {
   void set_thread_governor(const ThreadGovernor& g) { governor_ = g; }
   const ThreadGovernor& thread_governor() const { return governor_; }
   std::size_t num_membranes() const { return membranes_.size(); }
+  /// χ of the last trial (empty without a viscosity contrast).
+  const Array3& viscosity_indicator() const { return chi_; }
   /// Committed positions of membrane m.
   std::vector<Vec3> membrane_positions(std::size_t m) const;
   /// Committed node velocities of membrane m.
@@ -90,6 +101,8 @@ class ImmersedBoundaryOperator final : public CoupledOperator {
   /// Returns the seconds spent on work that not every evaluation does (the start force, the fluid preparation),
   /// which the thread governor leaves out of its comparison.
   double trial_step(std::span<const double> Xf, double theta, double dt);
+  /// χ_ at the midpoint (X^n + Xf)/2 (with a viscosity contrast).
+  void update_indicator(std::span<const Vec3> Xf);
   /// Runs one evaluation of the residual with the thread count the governor chooses, and reports its time.
   template <class F>
   void governed(F&& evaluation);
@@ -118,6 +131,10 @@ class ImmersedBoundaryOperator final : public CoupledOperator {
   std::optional<ContactForce> contact_;                 ///< when its range is positive
   std::vector<Vec3> contact_F_;                         ///< contact forces, all membranes
   std::vector<std::vector<Vec3>> Fm_;                   ///< per-membrane forces of compute_force
+  std::vector<double> ratio_;                           ///< λ of each membrane, with a viscosity contrast
+  std::unique_ptr<ViscosityIndicator> indicator_;       ///< with a viscosity contrast
+  std::vector<std::vector<Vec3>> Xmid_;                 ///< per-membrane midpoint positions of the trial
+  Array3 chi_;                                          ///< χ of the last trial
   std::size_t solves_ = 0;
   StepTimings timings_;
   ThreadGovernor governor_;

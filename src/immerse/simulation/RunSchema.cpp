@@ -60,6 +60,9 @@ ConfigSchema membrane_schema() {
   m.add_double("area_modulus", 0.0, Range::non_negative(),
                "k_A of the global area constraint E_A = k_A (A - A0)^2 / (2 A0), A0 the initial area (N/m: k_A dA/A0 "
                "is the isotropic tension it adds); 0 switches it off");
+  m.add_double("viscosity_ratio", 1.0, Range::closed(0.1, 10),
+               "viscosity ratio lambda = mu_in / mu_out of the fluid inside this membrane to fluid.mu outside; 1: the "
+               "same fluid (docs/viscosity-contrast.md)");
   m.add_string("volume_correction", "none", {"none", "normal_shift"},
                "after each accepted step: nothing, or move all nodes along their normals by one common distance "
                "that restores the initial volume exactly (the fluid is not changed; docs/volume-conservation.md)");

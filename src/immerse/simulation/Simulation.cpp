@@ -45,6 +45,11 @@ FluidParams make_fluid(const io::Config& c) {
   p.body_force = c.get<Vec3>("fluid.body_force");
   p.pressure = c.get<std::string>("fluid.pressure") == "extrapolated" ? PressurePredictor::Extrapolated
                                                                         : PressurePredictor::Lagged;
+  for (std::size_t i = 0; i < c.count("membrane"); ++i) {
+    const double ratio = c.entry("membrane", i).get<double>("viscosity_ratio");
+    if (ratio != 1.0) p.variable_viscosity = true;
+    p.implicit_ratio = std::max(p.implicit_ratio, ratio);
+  }
   for (int d = 0; d < 3; ++d) {
     p.wall_lower[d] = c.get<Vec3>(std::string("boundary.") + kAxes[d] + "_lower_velocity");
     p.wall_upper[d] = c.get<Vec3>(std::string("boundary.") + kAxes[d] + "_upper_velocity");
@@ -154,7 +159,7 @@ Simulation::Simulation(const io::Config& config)
   std::vector<const ElasticMembrane*> ms;
   for (auto& m : membranes_) ms.push_back(m.get());
   op_ = std::make_unique<ImmersedBoundaryOperator>(fluid_, coupler_, ms, initial_, initial_fluid_state(),
-                                                   make_contact(config));
+                                                   make_contact(config), viscosity_ratio_);
   op_->set_thread_governor(threads_);
   integrator_ = make_integrator(config.get<std::string>("time.scheme"), make_settings(config));
   if (integrator_->name() == "bfgs" && op_->size() > DenseBfgs::max_unknowns)
@@ -233,6 +238,7 @@ void Simulation::add_membrane(const io::Config& m, Mesh mesh, std::vector<Vec3> 
   corrected_volume_.push_back(m.get<std::string>("volume_correction") == "normal_shift"
                                   ? std::optional<double>(volume(mesh, initial))
                                   : std::nullopt);
+  viscosity_ratio_.push_back(m.get<double>("viscosity_ratio"));
   meshes_.push_back(std::move(mesh));
   references_.push_back(std::move(reference));
   initial_.push_back(std::move(initial));
@@ -292,6 +298,7 @@ void Simulation::pack_membranes() {
   initial_.clear();
   membranes_.clear();
   corrected_volume_.clear();
+  viscosity_ratio_.clear();
   for (const auto& place : packing.placements()) {
     Mesh mesh = tmpl;
     std::vector<Vec3> X, R;
@@ -330,6 +337,13 @@ void Simulation::check_geometry() const {
       std::ostringstream s;
       s << membrane_name(m) << " comes within " << d << " m of a wall: must keep at least one cell (" << h
         << " m) clear for the delta function" << unit_hint(config_, m);
+      throw InputError(s.str());
+    }
+    // The interior indicator reaches about two cells beyond the surface and must vanish within three of a wall.
+    if (viscosity_ratio_[m] != 1.0 && d < 5 * h) {
+      std::ostringstream s;
+      s << membrane_name(m) << ".viscosity_ratio = " << viscosity_ratio_[m] << ": the membrane comes within " << d
+        << " m of a wall and must keep at least five cells (" << 5 * h << " m) clear with a viscosity contrast";
       throw InputError(s.str());
     }
   }
@@ -485,6 +499,8 @@ io::Checkpoint Simulation::checkpoint() const {
     const std::vector<std::size_t> shape{std::size_t(u.nz()), std::size_t(u.ny()), std::size_t(u.nx())};
     ck.put_array("fluid.u" + std::to_string(d), u.values(), shape);
     ck.put_array("fluid.adv" + std::to_string(d), f.adv[d].values(), shape);
+    // u^{n-1}, which a variable viscosity extrapolates from (absent before the first step and without one).
+    if (f.u_prev[d].size() == u.size()) ck.put_array("fluid.u_prev" + std::to_string(d), f.u_prev[d].values(), shape);
   }
   ck.put_array("fluid.p", f.p.values(), {std::size_t(f.p.nz()), std::size_t(f.p.ny()), std::size_t(f.p.nx())});
   ck.put_array("fluid.p_prev", f.p_prev.values(),
@@ -566,6 +582,11 @@ void Simulation::restore(const io::Checkpoint& ck) {
     const std::size_t n = f.u[d].values().size();
     f.u[d].values() = array("fluid.u" + std::to_string(d), n);
     f.adv[d].values() = array("fluid.adv" + std::to_string(d), n);
+    const std::string prev = "fluid.u_prev" + std::to_string(d);
+    if (ck.has(prev)) {
+      if (f.u_prev[d].size() != n) f.u_prev[d] = f.u[d];
+      f.u_prev[d].values() = array(prev, n);
+    }
   }
   f.p.values() = array("fluid.p", f.p.values().size());
   f.dt_prev = time_value("fluid.dt_prev");
@@ -608,7 +629,8 @@ void Simulation::restore(const io::Checkpoint& ck) {
   }
   std::vector<const ElasticMembrane*> ms;
   for (auto& m : membranes_) ms.push_back(m.get());
-  op_ = std::make_unique<ImmersedBoundaryOperator>(fluid_, coupler_, ms, X, std::move(f), make_contact(config_));
+  op_ = std::make_unique<ImmersedBoundaryOperator>(fluid_, coupler_, ms, X, std::move(f), make_contact(config_),
+                                                   viscosity_ratio_);
   integrator_->set_history(prev_X, prev_dt, guess_errors);
   stepper_.set_state(dt, static_cast<int>(successes));
   step_ = step;

@@ -82,6 +82,7 @@ class Simulation {
   std::vector<std::unique_ptr<ElasticMembrane>> membranes_;
   /// The initial volume of each membrane whose volume is restored after every step (volume_correction).
   std::vector<std::optional<double>> corrected_volume_;
+  std::vector<double> viscosity_ratio_;  ///< λ = μ_in/μ_out of each membrane
   std::unique_ptr<ImmersedBoundaryOperator> op_;
   std::unique_ptr<MembraneIntegrator> integrator_;
   AdaptiveStepper stepper_;
