@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Regenerates every figure in docs/figures/ from the quick scenarios, in one command:
 #   bash scripts/make-figures.sh            # JOBS=1 bash scripts/make-figures.sh runs one simulation at a time
+#   FORMAT=pdf FIGURES=out/vector bash scripts/make-figures.sh   # vector figures (pdf or svg) into another folder
 # Builds the release program if needed, runs (two at a time by default, ~1-3 minutes each on an idle core)
 #   oscillating_membrane_quick at mu = 0.01 and 0.1                        (§4.1,   Figs. 2-5)
 #   capsule_shear_quick at G = 0.0125, 0.05 and 0.1                       (§4.2.1, Fig. 7)
@@ -17,7 +18,9 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 python=/usr/bin/python3
 runs=out/figures
-figs=docs/figures
+figs=${FIGURES:-docs/figures}
+ext=${FORMAT:-png}
+case $ext in png | pdf | svg) ;; *) echo "make-figures: FORMAT=$ext: expected png, pdf or svg"; exit 2 ;; esac
 jobs_max=${JOBS:-2}
 mkdir -p "$runs" "$figs"
 
@@ -97,21 +100,21 @@ start rbc_channel_quick "$runs/channel" --set output.fluid_fields=false
 wait
 if compgen -G "$runs/*.failed" >/dev/null; then echo "some runs failed: no figures written"; exit 1; fi
 
-$python scripts/plot_iterations.py "$runs/osc_mu0.01" -o "$figs/fig2_iterations.png"
-$python scripts/plot_shapes.py "$runs/osc_mu0.01" --frames 0,1,2,10 -o "$figs/fig3_shapes.png"
-$python scripts/plot_semi_axes.py "$runs/osc_mu0.01" -o "$figs/fig4_semi_axes_mu0.01.png"
-$python scripts/plot_semi_axes.py "$runs/osc_mu0.1" -o "$figs/fig5_semi_axes_mu0.1.png"
-$python scripts/plot_taylor.py "$runs"/shear_G0.0125 "$runs"/shear_G0.05 "$runs"/shear_G0.1 -o "$figs/fig7_taylor.png"
-$python scripts/plot_taylor.py "$runs"/oblate_ba0.9_G0.1 "$runs"/oblate_ba0.9_G0.2 -o "$figs/fig8_oblate_ba0.9.png"
-$python scripts/plot_taylor.py "$runs"/oblate_ba0.5_G0.2 -o "$figs/fig9_oblate_ba0.5.png"
+$python scripts/plot_iterations.py "$runs/osc_mu0.01" -o "$figs/fig2_iterations.$ext"
+$python scripts/plot_shapes.py "$runs/osc_mu0.01" --frames 0,1,2,10 -o "$figs/fig3_shapes.$ext"
+$python scripts/plot_semi_axes.py "$runs/osc_mu0.01" -o "$figs/fig4_semi_axes_mu0.01.$ext"
+$python scripts/plot_semi_axes.py "$runs/osc_mu0.1" -o "$figs/fig5_semi_axes_mu0.1.$ext"
+$python scripts/plot_taylor.py "$runs"/shear_G0.0125 "$runs"/shear_G0.05 "$runs"/shear_G0.1 -o "$figs/fig7_taylor.$ext"
+$python scripts/plot_taylor.py "$runs"/oblate_ba0.9_G0.1 "$runs"/oblate_ba0.9_G0.2 -o "$figs/fig8_oblate_ba0.9.$ext"
+$python scripts/plot_taylor.py "$runs"/oblate_ba0.5_G0.2 -o "$figs/fig9_oblate_ba0.5.$ext"
 if [[ ${FIG10:-1} == 1 ]]; then
   $python scripts/plot_taylor.py "$runs"/refine_64_octahedral "$runs"/refine_64_icosahedral "$runs"/refine_96_icosahedral \
-    --title "Oblate capsule, b/a = 0.9, G = 0.2: grid refinement" -o "$figs/fig10_refinement.png"
+    --title "Oblate capsule, b/a = 0.9, G = 0.2: grid refinement" -o "$figs/fig10_refinement.$ext"
 fi
-$python scripts/plot_taylor.py "$runs"/bending_G0.05_kB{0,0.01,0.025,0.0375} -o "$figs/fig11_bending_G0.05.png"
-$python scripts/plot_taylor.py "$runs"/bending_G0.2_kB{0,0.04,0.1,0.15} -o "$figs/fig11b_bending_G0.2.png"
-$python scripts/plot_shapes.py "$runs/osc_euler" --frames 0,3,6,-1 -o "$figs/fig6_explicit_shapes.png"
-$python scripts/plot_shapes.py "$runs/osc_jfnk" --frames 0,3,6,-1 -o "$figs/fig6_implicit_shapes.png"
-$python scripts/plot_stretch.py "$runs"/rbc_mu0_7.3 "$runs"/rbc_mu0_10 -o "$figs/fig13_stretch.png"
-$python scripts/plot_shapes.py "$runs"/rbc_mu0_7.3 --forces 0,38.9,110,194 --view 35,-60 -o "$figs/fig14_rbc_shapes.png"
-$python scripts/plot_shapes.py "$runs/channel" --frames 0,-1 --box --side x --columns 1 -o "$figs/fig15_channel.png"
+$python scripts/plot_taylor.py "$runs"/bending_G0.05_kB{0,0.01,0.025,0.0375} -o "$figs/fig11_bending_G0.05.$ext"
+$python scripts/plot_taylor.py "$runs"/bending_G0.2_kB{0,0.04,0.1,0.15} -o "$figs/fig11b_bending_G0.2.$ext"
+$python scripts/plot_shapes.py "$runs/osc_euler" --frames 0,3,6,-1 -o "$figs/fig6_explicit_shapes.$ext"
+$python scripts/plot_shapes.py "$runs/osc_jfnk" --frames 0,3,6,-1 -o "$figs/fig6_implicit_shapes.$ext"
+$python scripts/plot_stretch.py "$runs"/rbc_mu0_7.3 "$runs"/rbc_mu0_10 -o "$figs/fig13_stretch.$ext"
+$python scripts/plot_shapes.py "$runs"/rbc_mu0_7.3 --forces 0,38.9,110,194 --view 35,-60 -o "$figs/fig14_rbc_shapes.$ext"
+$python scripts/plot_shapes.py "$runs/channel" --frames 0,-1 --box --side x --columns 1 -o "$figs/fig15_channel.$ext"
