@@ -1,5 +1,7 @@
 #include "immerse/app/Scenario.hpp"
 
+#include "immerse/simulation/RunSchema.hpp"
+
 #include <algorithm>
 #include <cctype>
 #include <cmath>
@@ -25,9 +27,7 @@ std::string brief(double v) {  // for messages
   std::snprintf(buf, sizeof buf, "%.6g", v);
   return buf;
 }
-bool is_shear(const std::string& kind) {
-  return kind == "capsule_shear" || kind == "oblate_shear" || kind == "bending_shear";
-}
+bool is_shear(const std::string& kind) { return is_shear_kind(kind); }
 }  // namespace
 
 double shear_rate(const io::Config& c) {
@@ -225,21 +225,6 @@ io::Config derive_centres(io::Config config) {
 
 // Why a key of a [[membrane]] entry does not apply to it, or "" if it does. In the shear scenarios the radius is the
 // length a of the groups G and Re, also for a mesh read from a file.
-std::string not_applying(const io::Config& m, const std::string& key, bool shear) {
-  const std::string reference = m.get<std::string>("reference");
-  if (m.get<std::string>("mesh.family") != "file")
-    return key == "mesh.file" || key == "mesh.scale" || key == "mesh.reference_file"
-               ? "does not apply unless mesh.family = \"file\""
-               : "";
-  if (key == "shape" || key == "semi_axes" || key == "aspect_ratio" || key == "inclination" || key == "R0" ||
-      (key == "radius" && !shear))
-    return "does not apply to mesh.family = \"file\" (the file gives the shape; use mesh.scale)";
-  if (key == "mesh.level") return "does not apply to mesh.family = \"file\" (the file gives the nodes)";
-  if (key == "reference_radius" && reference != "sphere") return "does not apply unless reference = \"sphere\"";
-  if (key == "mesh.reference_file" && reference != "file") return "does not apply unless reference = \"file\"";
-  return "";
-}
-
 // The keys the user gave to a membrane they do not apply to.
 void check_membrane_keys(const io::Config& config) {
   const bool shear = is_shear(config.get<std::string>("scenario.kind"));
@@ -248,7 +233,7 @@ void check_membrane_keys(const io::Config& config) {
     const std::string p = "membrane[" + std::to_string(i) + "].";
     for (const auto& key : m.schema().keys())
       if (m.given(key.key))
-        if (const std::string why = not_applying(m, key.key, shear); !why.empty())
+        if (const std::string why = membrane_key_not_applying(m, key.key, shear); !why.empty())
           throw InputError(p + key.key + ": " + why);
     if (m.get<std::string>("reference") == "file" && m.get<std::string>("mesh.family") != "file")
       throw InputError(p + "reference = \"file\": must be \"initial\" or \"sphere\" unless mesh.family = "
@@ -272,15 +257,6 @@ io::Config derive(const io::Config& config) {
 }
 
 }  // namespace
-
-void leave_out_inapplicable(io::Config& config) {
-  const bool shear = is_shear(config.get<std::string>("scenario.kind"));
-  for (std::size_t i = 0; i < config.count("membrane"); ++i) {
-    const std::string p = "membrane[" + std::to_string(i) + "].";
-    for (const auto& key : config.entry("membrane", i).schema().keys())
-      if (!not_applying(config.entry("membrane", i), key.key, shear).empty()) config.leave_out(p + key.key);
-  }
-}
 
 io::Config apply_scenario(const io::Config& config) {
   check_membrane_keys(config);

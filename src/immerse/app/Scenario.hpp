@@ -29,8 +29,6 @@ namespace immerse {
 /// is refused when the user gave it and left out of the written configuration otherwise.
 io::Config apply_scenario(const io::Config& config);
 
-/// Marks the keys of each [[membrane]] entry that do not apply to it as left out (io::Config::leave_out).
-void leave_out_inapplicable(io::Config& config);
 
 /// rbc_channel: the centres of the 32 cells (see above).
 std::vector<Vec3> channel_cell_centres(const io::Config& config);

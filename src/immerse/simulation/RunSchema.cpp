@@ -187,4 +187,32 @@ ConfigSchema run_schema() {
   return s;
 }
 
+bool is_shear_kind(const std::string& kind) {
+  return kind == "capsule_shear" || kind == "oblate_shear" || kind == "bending_shear";
+}
+
+std::string membrane_key_not_applying(const io::Config& m, const std::string& key, bool shear) {
+  const std::string reference = m.get<std::string>("reference");
+  if (m.get<std::string>("mesh.family") != "file")
+    return key == "mesh.file" || key == "mesh.scale" || key == "mesh.reference_file"
+               ? "does not apply unless mesh.family = \"file\""
+               : "";
+  if (key == "shape" || key == "semi_axes" || key == "aspect_ratio" || key == "inclination" || key == "R0" ||
+      (key == "radius" && !shear))
+    return "does not apply to mesh.family = \"file\" (the file gives the shape; use mesh.scale)";
+  if (key == "mesh.level") return "does not apply to mesh.family = \"file\" (the file gives the nodes)";
+  if (key == "reference_radius" && reference != "sphere") return "does not apply unless reference = \"sphere\"";
+  if (key == "mesh.reference_file" && reference != "file") return "does not apply unless reference = \"file\"";
+  return "";
+}
+
+void leave_out_inapplicable(io::Config& config) {
+  const bool shear = is_shear_kind(config.get<std::string>("scenario.kind"));
+  for (std::size_t i = 0; i < config.count("membrane"); ++i) {
+    const std::string p = "membrane[" + std::to_string(i) + "].";
+    for (const auto& key : config.entry("membrane", i).schema().keys())
+      if (!membrane_key_not_applying(config.entry("membrane", i), key.key, shear).empty()) config.leave_out(p + key.key);
+  }
+}
+
 }  // namespace immerse

@@ -20,7 +20,7 @@
 #include "immerse/membrane/Yeoh.hpp"
 #include "immerse/simulation/CellPacking.hpp"
 #include "immerse/simulation/MembraneClearance.hpp"
-#include "immerse/app/Scenario.hpp"
+#include "immerse/simulation/RunSchema.hpp"
 #include "immerse/timestep/DenseBfgs.hpp"
 
 namespace immerse {
@@ -147,6 +147,8 @@ std::string unit_hint(const io::Config& config, std::size_t m) {
 
 Simulation::Simulation(const io::Config& config)
     : config_(config),
+      end_time_(config.get<double>("time.end")),
+      max_speed_(config.get<double>("time.max_speed")),
       grid_(make_grid(config)),
       threads_(ThreadGovernor::from_environment()),
       fluid_(grid_, make_fluid(config),
@@ -404,12 +406,12 @@ FluidState Simulation::initial_fluid_state() const {
   return s;
 }
 
-bool Simulation::finished() const { return time() >= config_.get<double>("time.end") * (1 - 1e-12); }
+bool Simulation::finished() const { return time() >= end_time_ * (1 - 1e-12); }
 
 StepRecord Simulation::advance(const std::function<void(const std::string&)>& log,
                                const std::function<bool()>& stop_requested) {
   const auto t0 = std::chrono::steady_clock::now();
-  const double remaining = config_.get<double>("time.end") - time();
+  const double remaining = end_time_ - time();
   StepRecord r;
   std::ostringstream where;
   where.precision(10);
@@ -442,7 +444,7 @@ StepRecord Simulation::advance(const std::function<void(const std::string&)>& lo
 }
 
 void Simulation::check_stability(const StepRecord& r) const {
-  const double vmax = config_.get<double>("time.max_speed");
+  const double vmax = max_speed_;
   for (std::size_t m = 0; m < num_membranes(); ++m) {
     const auto X = op_->membrane_positions(m);
     const auto U = op_->membrane_velocities(m);

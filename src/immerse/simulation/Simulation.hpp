@@ -73,6 +73,8 @@ class Simulation {
   void check_stability(const StepRecord& r) const;
 
   io::Config config_;
+  double end_time_;   ///< time.end and time.max_speed, read once (the run's configuration does not change)
+  double max_speed_;
   Grid grid_;
   ThreadGovernor threads_;  ///< first: sets OpenMP's thread count (cgroup quota) before the FFT plans are made
   NavierStokesSolver fluid_;
