@@ -1,10 +1,10 @@
 // scenarios/capsule_pair_quick.toml (two neo-Hookean capsules, G = 0.05, 642 nodes each, crossing in simple shear
 // from dx/a = -4, dz/a = 0.75; Lac, Morel & Barthes-Biesel, J. Fluid Mech. 573, 149-169 (2007)) in a box half as
-// deep along y (4a instead of 8a: a 48 x 12 x 24 grid, 180 steps to k t = 9), checked against the physics of the crossing: the upper capsule passes the lower one (dx changes sign), the
-// gradient-direction separation dz ends above its initial value (the irreversible drift) after rising while the two
-// overlap along x, the motion is the same for both capsules (equal and opposite centroid displacements, equal
-// Taylor deformation, by the symmetry of the pair about the box centre), and no node of one capsule ever lies inside
-// the other (winding number, MembraneClearance.hpp).
+// deep along y (4a instead of 8a: a 48 x 12 x 24 grid, 180 steps to k t = 9), checked against the physics of the
+// crossing: the upper capsule passes the lower one (dx changes sign), the gradient-direction separation dz rises
+// while the two overlap along x and ends above its initial value (the irreversible drift), the motion is the same
+// for both capsules (equal and opposite centroid displacements, equal volumes, by the symmetry of the pair about the
+// box centre), and no node of one capsule ever lies inside the other (winding number, MembraneClearance.hpp).
 #include <gtest/gtest.h>
 
 #include <algorithm>
