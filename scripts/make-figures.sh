@@ -11,6 +11,7 @@
 #   bending_shear_quick at G = 0.2, kappa_B_hat = 0, 0.04, 0.1, 0.15 to k t = 4       (§4.2.3, Fig. 11b)
 #   rbc_channel_quick, 32 cells to t = 0.05 s                                         (§4.4, Fig. 15)
 #   rbc_stretch_quick at mu0 = 7.3, 10 uN/m, forces 0, 38.9, 110, 194 pN, looser steady state  (§4.3, Figs. 13-14)
+#   capsule_pair_quick and capsule_pair, two capsules crossing in shear (Lac, Morel & Barthes-Biesel 2007)
 # and the paper-size refinement study oblate_shear, b/a = 0.9, G = 0.2 at 64^3 (4,098 and 10,242 nodes) and 96^3
 # (10,242 nodes) (§4.2.2, Fig. 10; 10-30 minutes each on one core; FIG10=0 leaves it out)
 # into out/figures/, then plots with Debian's matplotlib (/usr/bin/python3). Each plot script prints its key numbers.
@@ -95,6 +96,9 @@ if [[ ${FIG10:-1} == 1 ]]; then
       --set output.fields_every=0
   done
 fi
+# Two capsules crossing in shear (Lac et al. 2007): trajectory and shapes; the finer size too (about 80 s on two cores).
+start capsule_pair_quick "$runs/pair"
+start capsule_pair "$runs/pair_full" --set output.fields_every=0
 # Fig. 15: the 32 cells of the quick channel at t = 0 and t = 0.05 s (the longest of these runs).
 start rbc_channel_quick "$runs/channel" --set output.fluid_fields=false
 wait
@@ -118,3 +122,6 @@ $python scripts/plot_shapes.py "$runs/osc_jfnk" --frames 0,3,6,-1 -o "$figs/fig6
 $python scripts/plot_stretch.py "$runs"/rbc_mu0_7.3 "$runs"/rbc_mu0_10 -o "$figs/fig13_stretch.$ext"
 $python scripts/plot_shapes.py "$runs"/rbc_mu0_7.3 --forces 0,38.9,110,194 --view 35,-60 -o "$figs/fig14_rbc_shapes.$ext"
 $python scripts/plot_shapes.py "$runs/channel" --frames 0,-1 --box --side x --columns 1 -o "$figs/fig15_channel.$ext"
+$python scripts/plot_pair.py "$runs/pair" "$runs/pair_full" -o "$figs/capsule_pair.$ext"
+$python scripts/plot_shapes.py "$runs/pair" --frames 0,5,6,9 --side y --columns 2 \
+  --title "Two capsules crossing in shear, G = 0.05, seen along y" -o "$figs/capsule_pair_shapes.$ext"
