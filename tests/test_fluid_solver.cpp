@@ -13,7 +13,7 @@
 
 #include "immerse/core/Error.hpp"
 #include "immerse/fluid/ExactSolutions.hpp"
-#include "immerse/fluid/FastSolver.hpp"
+#include "immerse/fluid/FftHelmholtzSolver.hpp"
 #include "immerse/fluid/FluidDiagnostics.hpp"
 #include "immerse/fluid/MacStencil_K.hpp"
 #include "immerse/fluid/NavierStokesSolver.hpp"
@@ -253,7 +253,7 @@ TEST(NavierStokesSolver, ForceOnWallFacesIsIgnored) {
 
 TEST(NavierStokesSolver, ResultsDoNotDependOnTheThreadCount) {
   const Grid g({64, 32, 32}, {2, 1, 1}, {P, W, W});  // large enough to be threaded
-  ASSERT_TRUE(MacGeom(g).threaded());
+  ASSERT_TRUE(MacStencilGrid(g).threaded());
   FluidParams prm;
   prm.mu = 0.05;
   prm.wall_upper[1] = {0.5, 0, 0.1};
@@ -279,7 +279,7 @@ TEST(NavierStokesSolver, ResultsDoNotDependOnTheThreadCount) {
 TEST(MacOperators, DivergenceIsMinusTheAdjointOfTheGradient) {
   for (auto bc : {std::array<Boundary, 3>{P, P, P}, {W, P, W}, {W, W, W}}) {
     const Grid g({6, 8, 10}, {0.6, 0.8, 1.0}, bc);
-    const MacGeom geom(g);
+    const MacStencilGrid geom(g);
     std::mt19937 rng(1);
     FaceField u(g);
     for (int d = 0; d < 3; ++d) randomize(u[d], rng);
@@ -301,7 +301,7 @@ TEST(MacOperators, DivergenceIsMinusTheAdjointOfTheGradient) {
 // The row kernels of the step's fast path (MacStencil_K.hpp) against the generic ones, on every face where they
 // apply, for every boundary combination and both accessors: the same operations in the same order, so bitwise.
 template <int D>
-int row_kernel_mismatches(const MacGeom& g, const FaceField& u, const Array3& p) {
+int row_kernel_mismatches(const MacStencilGrid& g, const FaceField& u, const Array3& p) {
   int bad = 0;
   const IndexBox box = interior_face_box(g, D);
   for (int k = box.begin[2]; k < box.end[2]; ++k)
@@ -342,7 +342,7 @@ TEST(MacOperators, RowKernelsEqualTheGenericOnesBitwise) {
       prm.wall_upper[a] = {-0.4, 0.5, 0.7};
       prm.wall_lower[a][a] = prm.wall_upper[a][a] = 0.25;
     }
-    const MacGeom geom(g, prm);
+    const MacStencilGrid geom(g, prm);
     std::mt19937 rng(static_cast<unsigned>(combo));
     FaceField u(g);
     for (int d = 0; d < 3; ++d) randomize(u[d], rng);
@@ -392,7 +392,7 @@ TEST(MacOperators, HomogeneousLaplacianIsSymmetricOnEveryLayout) {
 }
 
 // The eigen-systems of docs/theory/conventions.md: a product of the tabulated eigenvectors is reproduced by the solver.
-TEST(FastSolver, ReproducesTheTabulatedEigenvectors) {
+TEST(FftHelmholtzSolver, ReproducesTheTabulatedEigenvectors) {
   const Grid g({8, 6, 10}, {0.8, 0.6, 1.0}, {W, P, W});
   const double h = g.h();
   const auto lam_wall = [&](int k, int n) { return -4 / (h * h) * std::pow(std::sin(pi * k / (2.0 * n)), 2); };
@@ -427,12 +427,12 @@ TEST(FastSolver, ReproducesTheTabulatedEigenvectors) {
         EXPECT_NEAR(residual[n], b[n], 1e-12) << "layout " << l;
       }
     }
-    FastSolver(g, layout, FftPlanning::Estimate).solve(b, alpha, beta);
+    FftHelmholtzSolver(g, layout, FftPlanning::Estimate).solve(b, alpha, beta);
     for (std::size_t n = 0; n < b.size(); ++n) EXPECT_NEAR(b[n], x[n], 1e-13) << "layout " << l;
   }
 }
 
-TEST(FastSolver, HelmholtzSolutionMatchesTheManufacturedOne) {
+TEST(FftHelmholtzSolver, HelmholtzSolutionMatchesTheManufacturedOne) {
   std::mt19937 rng(4);
   for (auto bc : {std::array<Boundary, 3>{P, W, P}, {W, W, W}}) {
     const Grid g({6, 10, 8}, {0.6, 1.0, 0.8}, bc);
@@ -440,13 +440,13 @@ TEST(FastSolver, HelmholtzSolutionMatchesTheManufacturedOne) {
       const auto s = g.face_shape(l);
       Array3 x(s[0], s[1], s[2]);
       randomize(x, rng);
-      const MacGeom geom(g);
+      const MacStencilGrid geom(g);
       // zero the wall faces (not unknowns)
       Array3 xu(s[0], s[1], s[2]);
       for_each_face(geom, l, [&](int i, int j, int k) { xu(i, j, k) = x(i, j, k); });
       Array3 b;
       apply_operator(g, static_cast<Layout>(l), xu, 1.0, -0.05, b);
-      FastSolver(g, static_cast<Layout>(l), FftPlanning::Estimate).solve(b, 1.0, -0.05);
+      FftHelmholtzSolver(g, static_cast<Layout>(l), FftPlanning::Estimate).solve(b, 1.0, -0.05);
       for (std::size_t n = 0; n < b.size(); ++n) EXPECT_NEAR(b[n], xu[n], 1e-12);
     }
   }

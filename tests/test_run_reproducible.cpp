@@ -1,6 +1,6 @@
 // A run is reproducible bit for bit in separate processes: with one and with two threads, and when continued from
 // a checkpoint by a new process (with either pressure of (9)). The grid (44^3 cells) is above
-// MacGeom::kMinCellsForThreads, so the fluid solvers' loops and FFTW's transforms run threaded with two threads.
+// MacStencilGrid::kMinCellsForThreads, so the fluid solvers' loops and FFTW's transforms run threaded with two threads.
 // This holds with fluid.fft_planning = "estimate" (the default), whose FFTW plans do not depend on timings; with
 // "measure" the plans, and so the round-off, may change from one process to the next (docs/performance.md,
 // "Reproducibility").

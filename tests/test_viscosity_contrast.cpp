@@ -79,7 +79,7 @@ FluidState integrate(const VariableViscosityMms& mms, int n, double dt, int step
   a.u_prev = FaceField(grid);
   sample_velocity(grid, [&](const Vec3& x) { return mms.velocity(x, -dt); }, a.u_prev);
   sample_pressure(grid, [&](const Vec3& x) { return mms.pressure(x, -1.5 * dt); }, a.p_prev);
-  const MacGeom g(grid);
+  const MacStencilGrid g(grid);
   for (int d = 0; d < 3; ++d)
     for_each_face(g, d, [&](int i, int j, int k) {
       const mac::Index q{i, j, k};
@@ -155,7 +155,7 @@ std::pair<double, double> closed_box_errors(int n) {
   sample_velocity(grid, [&](const Vec3& x) { return mms.velocity(x, -dt); }, a.u_prev);
   ns.apply_wall_values(a.u_prev);
   sample_pressure(grid, [&](const Vec3& x) { return mms.pressure(x, -1.5 * dt); }, a.p_prev);
-  const MacGeom g(grid, prm);
+  const MacStencilGrid g(grid, prm);
   for (int d = 0; d < 3; ++d)
     for_each_face(g, d, [&](int i, int j, int k) {
       const mac::Index q{i, j, k};
@@ -232,7 +232,7 @@ TEST(ViscosityContrast, ViscosityWithinThreeCellsOfAWallIsRefused) {
 TEST(ViscosityContrast, StressOfConstantViscosityIsTheLaplacian) {
   // χ constant: ∇_h·(χ(∇_h u + ∇_h uᵀ)) = χ (∇_h² u + G D u) for any u, on every face of a periodic grid.
   const Grid grid({6, 5, 7}, {6.0, 5.0, 7.0}, {P, P, P});
-  const MacGeom g(grid);
+  const MacStencilGrid g(grid);
   std::mt19937 rng(3);
   std::uniform_real_distribution<double> U(-1, 1);
   FaceField u(grid);

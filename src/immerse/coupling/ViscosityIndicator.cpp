@@ -3,7 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
-#include "immerse/fluid/MacGeom.hpp"
+#include "immerse/fluid/MacStencilGrid.hpp"
 #include "immerse/fluid/MacStencil_K.hpp"
 #include "immerse/membrane/VolumeAreaConstraint.hpp"
 
@@ -12,7 +12,7 @@ namespace immerse {
 ViscosityIndicator::ViscosityIndicator(IBCoupler& coupler, FftPlanning planning)
     : coupler_(coupler),
       work_(coupler.grid().n(0), coupler.grid().n(1), coupler.grid().n(2)),
-      solver_(std::make_unique<FastSolver>(coupler.grid(), Layout::Pressure, planning, &work_)),
+      solver_(std::make_unique<FftHelmholtzSolver>(coupler.grid(), Layout::Pressure, planning, &work_)),
       normals_(coupler.grid()) {}
 
 void ViscosityIndicator::compute(std::span<const IndicatorSurface> surfaces, Array3& chi) {
@@ -39,7 +39,7 @@ void ViscosityIndicator::compute(std::span<const IndicatorSurface> surfaces, Arr
   }
   coupler_.spread_force(X_, N_, normals_);
   // ∇_h² χ = −D_h G (wall faces carry no G: the membranes stay away from the walls).
-  const MacGeom g(grid);
+  const MacStencilGrid g(grid);
   for_each_cell(g, [&](int i, int j, int k) { work_(i, j, k) = -mac::divergence_cell(normals_, g, {i, j, k}); });
   solver_->solve(work_, 0.0, 1.0);
   // The free constant: Σ χ h³ = Σ_m (λ_m − 1) V_m (a serial sum: the same in every thread count).

@@ -22,7 +22,7 @@
 #include "immerse/core/Array3.hpp"
 #include "immerse/core/Vec3.hpp"
 #include "immerse/coupling/IBCoupler.hpp"
-#include "immerse/fluid/FastSolver.hpp"
+#include "immerse/fluid/FftHelmholtzSolver.hpp"
 #include "immerse/grid/FaceField.hpp"
 
 namespace immerse {
@@ -53,7 +53,7 @@ class ViscosityIndicator {
  private:
   IBCoupler& coupler_;
   Array3 work_;  // the Poisson solver's own array
-  std::unique_ptr<FastSolver> solver_;
+  std::unique_ptr<FftHelmholtzSolver> solver_;
   FaceField normals_;             // G on the faces
   std::vector<Vec3> X_, N_;       // nodes and weighted normals of all contributing membranes
   double target_ = 0;

@@ -22,7 +22,7 @@ struct Accumulator {
 
 // Serial loop over the unknowns of component d (diagnostics: reproducible sums, no threading needed).
 template <class F>
-void serial_faces(const MacGeom& g, int d, F&& f) {
+void serial_faces(const MacStencilGrid& g, int d, F&& f) {
   for (int k = g.first(d, 2); k < g.n[2]; ++k)
     for (int j = g.first(d, 1); j < g.n[1]; ++j)
       for (int i = g.first(d, 0); i < g.n[0]; ++i) f(i, j, k);
@@ -37,13 +37,13 @@ double mean(const Array3& a) {
 }  // namespace
 
 void divergence(const Grid& grid, const FaceField& u, Array3& div) {
-  const MacGeom g(grid);
+  const MacStencilGrid g(grid);
   div = Array3(grid.n(0), grid.n(1), grid.n(2));
   for_each_cell(g, [&](int i, int j, int k) { div(i, j, k) = mac::divergence_cell(u, g, {i, j, k}); });
 }
 
 double max_abs_velocity(const Grid& grid, const FaceField& u) {
-  const MacGeom g(grid);
+  const MacStencilGrid g(grid);
   double m = 0;
   for (int d = 0; d < 3; ++d)
     serial_faces(g, d, [&](int i, int j, int k) { m = std::max(m, std::abs(u[d](i, j, k))); });
@@ -51,7 +51,7 @@ double max_abs_velocity(const Grid& grid, const FaceField& u) {
 }
 
 void apply_operator(const Grid& grid, Layout layout, const Array3& x, double alpha, double beta, Array3& out) {
-  const MacGeom g(grid);
+  const MacStencilGrid g(grid);
   out = Array3(x.nx(), x.ny(), x.nz());
   if (layout == Layout::Pressure) {
     for_each_cell(g, [&](int i, int j, int k) {
@@ -68,7 +68,7 @@ void apply_operator(const Grid& grid, Layout layout, const Array3& x, double alp
 double relative_residual(const Grid& grid, Layout layout, const Array3& x, const Array3& b, double alpha, double beta) {
   Array3 ax;
   apply_operator(grid, layout, x, alpha, beta, ax);
-  const MacGeom g(grid);
+  const MacStencilGrid g(grid);
   const int d = layout == Layout::Pressure ? -1 : static_cast<int>(layout);
   double r = 0, bmax = 0;
   serial_faces(g, d, [&](int i, int j, int k) {
@@ -79,7 +79,7 @@ double relative_residual(const Grid& grid, Layout layout, const Array3& x, const
 }
 
 ErrorNorms velocity_error(const Grid& grid, const FaceField& u, const std::function<Vec3(const Vec3&)>& exact) {
-  const MacGeom g(grid);
+  const MacStencilGrid g(grid);
   Accumulator acc;
   for (int d = 0; d < 3; ++d)
     serial_faces(g, d, [&](int i, int j, int k) { acc.add(u[d](i, j, k) - exact(grid.face_position(d, i, j, k))[d]); });
@@ -87,7 +87,7 @@ ErrorNorms velocity_error(const Grid& grid, const FaceField& u, const std::funct
 }
 
 ErrorNorms velocity_difference(const Grid& grid, const FaceField& a, const FaceField& b) {
-  const MacGeom g(grid);
+  const MacStencilGrid g(grid);
   Accumulator acc;
   for (int d = 0; d < 3; ++d) serial_faces(g, d, [&](int i, int j, int k) { acc.add(a[d](i, j, k) - b[d](i, j, k)); });
   return acc.norms();

@@ -5,7 +5,7 @@
 
 #include "immerse/core/Array3.hpp"
 #include "immerse/core/Vec3.hpp"
-#include "immerse/fluid/FastSolver.hpp"
+#include "immerse/fluid/FftHelmholtzSolver.hpp"
 #include "immerse/grid/FaceField.hpp"
 #include "immerse/grid/Grid.hpp"
 
@@ -17,7 +17,7 @@ void divergence(const Grid& grid, const FaceField& u, Array3& div);
 /// Largest |value| of velocity over the unknown faces (all components).
 double max_abs_velocity(const Grid& grid, const FaceField& u);
 
-/// out = (α I + β ∇_h²) x on the unknowns of `layout` with homogeneous walls (the operator FastSolver inverts;
+/// out = (α I + β ∇_h²) x on the unknowns of `layout` with homogeneous walls (the operator FftHelmholtzSolver inverts;
 /// ∇_h² of the pressure is D^MAC G^MAC with Neumann walls). Other entries of out are set to zero.
 void apply_operator(const Grid& grid, Layout layout, const Array3& x, double alpha, double beta, Array3& out);
 

@@ -4,7 +4,7 @@
 // (u·∇_h u) at a face. They read the arrays they are given and write nothing.
 //
 // Boundary values (eq. 3). Along a wall axis, velocity component d is
-//   - face-normal (axis d): the wall faces carry the normal wall velocity; it is taken from MacGeom, never
+//   - face-normal (axis d): the wall faces carry the normal wall velocity; it is taken from MacStencilGrid, never
 //     from the array, so the arrays' wall faces are only read by the divergence;
 //   - cell-centred (axis ≠ d): the value beyond the wall is the ghost u_g = 2 u_w − u_0, so that the mean of
 //     ghost and first interior value equals the wall velocity u_w.
@@ -14,7 +14,7 @@
 // Two forms of each kernel: the generic one at an index (wraps indices, branches on the boundary type at every
 // access; valid everywhere), and a *_row one that reads through an accessor of the neighbouring rows (Strided,
 // or WrappedRows on periodic boundary rows; no branch), valid wherever every value it reads is a stored one,
-// i.e. away from the wall layers (MacGeom::interior_begin/end). Both forms do the same floating-point operations
+// i.e. away from the wall layers (MacStencilGrid::interior_begin/end). Both forms do the same floating-point operations
 // in the same order, so they give bitwise the same result where both apply.
 // Verified by: the tests MacOperators.* (D = -G*, symmetric Laplacian, row kernels bitwise the generic ones on all 8
 // periodic/wall combinations) and the study fluid_divergence (D u after the projection, ≤ 1e-12).
@@ -22,7 +22,7 @@
 #include <cstddef>
 
 #include "immerse/core/Array3.hpp"
-#include "immerse/fluid/MacGeom.hpp"
+#include "immerse/fluid/MacStencilGrid.hpp"
 #include "immerse/grid/FaceField.hpp"
 
 namespace immerse::mac {
@@ -33,7 +33,7 @@ inline int wrap(int i, int n) { return i < 0 ? i + n : (i >= n ? i - n : i); }
 inline double at(const Array3& a, const Index& q) { return a(q[0], q[1], q[2]); }
 
 /// Velocity component e at face index r of its own array, with the normal wall velocity on wall faces.
-inline double face_value(const Array3& ue, const MacGeom& g, int e, const Index& r) {
+inline double face_value(const Array3& ue, const MacStencilGrid& g, int e, const Index& r) {
   if (!g.periodic[e]) {
     if (r[e] == 0) return g.wall_lower[e][e];
     if (r[e] == g.n[e]) return g.wall_upper[e][e];
@@ -42,7 +42,7 @@ inline double face_value(const Array3& ue, const MacGeom& g, int e, const Index&
 }
 
 /// Component d at the neighbour s = ±1 along axis e of its face q (periodic wrap, wall value or ghost).
-inline double neighbor(const Array3& ud, const MacGeom& g, int d, Index q, int e, int s) {
+inline double neighbor(const Array3& ud, const MacStencilGrid& g, int d, Index q, int e, int s) {
   const int m = q[e] + s;
   if (m > 0 && m < g.n[e]) {  // interior (the common case)
     q[e] = m;
@@ -66,7 +66,7 @@ struct FaceStencil {
   double minus[3], plus[3];
 };
 
-inline FaceStencil gather(const Array3& ud, const MacGeom& g, int d, const Index& q) {
+inline FaceStencil gather(const Array3& ud, const MacStencilGrid& g, int d, const Index& q) {
   FaceStencil st{at(ud, q), {}, {}};
   for (int e = 0; e < 3; ++e) {
     st.minus[e] = neighbor(ud, g, d, q, e, -1);
@@ -96,7 +96,7 @@ constexpr int unit(int A, int axis) { return A == axis ? 1 : 0; }
 struct Strided {
   const double* row;
   std::ptrdiff_t sy, sz;
-  Strided(const Array3& a, const MacGeom&, int j, int k)
+  Strided(const Array3& a, const MacStencilGrid&, int j, int k)
       : row(a.data() + a.index(0, j, k)), sy(a.nx()), sz(static_cast<std::ptrdiff_t>(a.nx()) * a.ny()) {}
   template <int DX, int DY, int DZ>
   double at(XIndex x) const {
@@ -106,7 +106,7 @@ struct Strided {
 
 /// Whether row (j, k) has neighbour rows that wrap (it lies on the boundary of a periodic y or z axis): then the
 /// kernels must read through WrappedRows.
-inline bool row_wraps(const MacGeom& g, int j, int k) {
+inline bool row_wraps(const MacStencilGrid& g, int j, int k) {
   return (g.periodic[1] && (j == 0 || j == g.n[1] - 1)) || (g.periodic[2] && (k == 0 || k == g.n[2] - 1));
 }
 
@@ -114,7 +114,7 @@ inline bool row_wraps(const MacGeom& g, int j, int k) {
 /// the array on a wall axis: such a row is never read where the row kernels apply).
 struct WrappedRows {
   const double* row[3][3];
-  WrappedRows(const Array3& a, const MacGeom& g, int j, int k) {
+  WrappedRows(const Array3& a, const MacStencilGrid& g, int j, int k) {
     for (int dz = -1; dz <= 1; ++dz)
       for (int dy = -1; dy <= 1; ++dy) {
         int jj = j + dy, kk = k + dz;
@@ -150,16 +150,16 @@ inline double laplacian(const FaceStencil& st, double inv_h2) {
   for (int e = 0; e < 3; ++e) s += st.minus[e] - 2.0 * st.centre + st.plus[e];
   return s * inv_h2;
 }
-inline double laplacian(const FaceStencil& st, const MacGeom& g) { return laplacian(st, g.inv_h2); }
+inline double laplacian(const FaceStencil& st, const MacStencilGrid& g) { return laplacian(st, g.inv_h2); }
 
 /// ∇_h² u_d at face q of component d, with the boundary values of g.
-inline double laplacian_face(const Array3& ud, const MacGeom& g, int d, const Index& q) {
+inline double laplacian_face(const Array3& ud, const MacStencilGrid& g, int d, const Index& q) {
   return laplacian(gather(ud, g, d, q), g);
 }
 
 /// Part of ∇_h² u_d at face q that comes from the wall velocities alone (∇_h² with walls minus ∇_h² with
 /// homogeneous walls): it moves to the right-hand side of the implicit Helmholtz problem (9).
-inline double wall_source_face(const MacGeom& g, int d, const Index& q) {
+inline double wall_source_face(const MacStencilGrid& g, int d, const Index& q) {
   double s = 0;
   for (int e = 0; e < 3; ++e) {
     if (g.periodic[e]) continue;
@@ -173,7 +173,7 @@ inline double wall_source_face(const MacGeom& g, int d, const Index& q) {
 
 /// Central-difference advection (u·∇_h u)_d at face q: Σ_e ū_e (u_d(q+e) − u_d(q−e)) / 2h, where ū_e is the
 /// mean of the four e-faces around face q (ū_d = u_d); st is the stencil of u_d at q.
-inline double advection_face(const FaceField& u, const MacGeom& g, int d, const Index& q, const FaceStencil& st) {
+inline double advection_face(const FaceField& u, const MacStencilGrid& g, int d, const Index& q, const FaceStencil& st) {
   double a = 0;
   for (int e = 0; e < 3; ++e) {
     double ue = st.centre;
@@ -220,7 +220,7 @@ inline double advection_row(const FaceStencil& st, const R& u0, const R& u1, con
 }
 
 /// (G^MAC p)_d at face q (an unknown face: never a wall face).
-inline double gradient_face(const Array3& p, const MacGeom& g, int d, const Index& q) {
+inline double gradient_face(const Array3& p, const MacStencilGrid& g, int d, const Index& q) {
   Index r = q;
   r[d] = g.periodic[d] ? wrap(q[d] - 1, g.n[d]) : q[d] - 1;
   return (at(p, q) - at(p, r)) * g.inv_h;
@@ -233,7 +233,7 @@ inline double gradient_row(const R& p, XIndex x, double inv_h) {
 }
 
 /// (D^MAC u) at cell q, from the face values stored in u (wall faces included).
-inline double divergence_cell(const FaceField& u, const MacGeom& g, const Index& q) {
+inline double divergence_cell(const FaceField& u, const MacStencilGrid& g, const Index& q) {
   double s = 0;
   for (int d = 0; d < 3; ++d) {
     Index r = q;
@@ -254,7 +254,7 @@ inline double divergence_row(const R& u0, const R& u1, const R& u2, XIndex x, do
 }
 
 /// D^MAC G^MAC φ at cell q: the 7-point Laplacian with ghost φ_g = φ_0 at walls (homogeneous Neumann).
-inline double laplacian_cell_neumann(const Array3& phi, const MacGeom& g, const Index& q) {
+inline double laplacian_cell_neumann(const Array3& phi, const MacStencilGrid& g, const Index& q) {
   const double c = at(phi, q);
   double s = 0;
   for (int e = 0; e < 3; ++e)

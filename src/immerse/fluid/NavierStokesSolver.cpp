@@ -70,7 +70,7 @@ inline double result_face(const RhsCoefficients& c, double un, double e, const d
 /// (u·∇_h u)^n (into adv) and the explicit terms of (9), or WithForce the right-hand side under `force` (into res),
 /// along row (j, k) of component D, i in [i0, i1) (no wall layer), reading through accessor R.
 template <int D, bool First, bool WithForce, class R>
-__attribute__((flatten)) void explicit_row(const MacGeom& g, const FluidState& in, const Array3& p,
+__attribute__((flatten)) void explicit_row(const MacStencilGrid& g, const FluidState& in, const Array3& p,
                                           const Array3* force, const RhsCoefficients& c, Array3& adv, Array3& res,
                                           int j, int k, int i0, int i1) {
   // Everything the loop reads in locals: the compiler then sees loop-invariant rows and vectorizes. Flattened: with
@@ -98,7 +98,7 @@ __attribute__((flatten)) void explicit_row(const MacGeom& g, const FluidState& i
 /// res at every unknown of component D (p: the pressure of (9)): the row kernels wherever they apply, the generic
 /// kernels in the wall layers.
 template <int D, bool First, bool WithForce>
-void build_t(const MacGeom& g, const FluidState& in, const Array3& p, const Array3* force, const RhsCoefficients& c,
+void build_t(const MacStencilGrid& g, const FluidState& in, const Array3& p, const Array3* force, const RhsCoefficients& c,
              Array3& adv, Array3& res) {
   const Array3& un = in.u[D];
   const double* const f = WithForce ? force->data() : nullptr;
@@ -124,7 +124,7 @@ void build_t(const MacGeom& g, const FluidState& in, const Array3& p, const Arra
 
 /// build_t for component d (force: its component d, WithForce).
 template <bool WithForce>
-void build(const MacGeom& g, int d, const FluidState& in, const Array3& p, const Array3* force,
+void build(const MacStencilGrid& g, int d, const FluidState& in, const Array3& p, const Array3* force,
            const RhsCoefficients& c, Array3& adv, Array3& res) {
   const bool first = first_step(in);
   const auto run = [&]<int D>() {
@@ -163,7 +163,7 @@ void rhs_row(const Array3& un, const Array3& ex, const Array3& f, const Array3& 
 
 /// D u* (into div) and the right-hand side (ρ/Δt) D u* of (11) (into phi) along row (j, k) of the cells.
 template <class R>
-void divergence_row(const MacGeom& g, const FaceField& us, double rho_dt, Array3& div, Array3& phi, int j, int k,
+void divergence_row(const MacStencilGrid& g, const FaceField& us, double rho_dt, Array3& div, Array3& phi, int j, int k,
                     int i0, int i1) {
   const R r0(us[0], g, j, k), r1(us[1], g, j, k), r2(us[2], g, j, k);
   double* const dr = div.data() + div.index(0, j, k);
@@ -178,7 +178,7 @@ void divergence_row(const MacGeom& g, const FaceField& us, double rho_dt, Array3
 
 /// (12) along row (j, k) of the unknowns of component D: u^{n+1} = u* − (Δt/ρ) G φ.
 template <int D, class R>
-void project_row(const MacGeom& g, const Array3& us, const Array3& phi, Array3& un1, int j, int k, int i0, int i1,
+void project_row(const MacStencilGrid& g, const Array3& us, const Array3& phi, Array3& un1, int j, int k, int i0, int i1,
                  double dt_rho) {
   const R rphi(phi, g, j, k);
   const std::size_t o = us.index(0, j, k);
@@ -194,7 +194,7 @@ void project_row(const MacGeom& g, const Array3& us, const Array3& phi, Array3& 
 /// each component in that row (face_box: a component normal to a wall has none in the wall's first row), then
 /// p^{n+1/2} = p0 + φ − (μ/2) D u* at the cells (p0: the pressure (9) took), keeping p^{n−1/2} (pn) as out.p_prev.
 template <class R>
-void project_and_update_row(const MacGeom& g, const FaceField& us, const Array3& phi, const Array3& div,
+void project_and_update_row(const MacStencilGrid& g, const FaceField& us, const Array3& phi, const Array3& div,
                             const Array3& p0, const Array3& pn, FluidState& out, int j, int k, double dt_rho,
                             double half_mu) {
   const int i1 = g.n[0];
@@ -232,7 +232,7 @@ NavierStokesSolver::NavierStokesSolver(const Grid& grid, const FluidParams& para
       phi_(grid.n(0), grid.n(1), grid.n(2)) {
   params_.validate(grid_);
   for (int l = 0; l < 4; ++l)
-    solvers_[l] = std::make_unique<FastSolver>(grid_, static_cast<Layout>(l), planning, l < 3 ? &ustar_[l] : &phi_);
+    solvers_[l] = std::make_unique<FftHelmholtzSolver>(grid_, static_cast<Layout>(l), planning, l < 3 ? &ustar_[l] : &phi_);
 }
 
 FluidState NavierStokesSolver::initial_state() const {
@@ -287,7 +287,7 @@ const Array3& NavierStokesSolver::momentum_pressure(const FluidState& in, double
   const double* const p = in.p.data();
   const double* const q = in.p_prev.data();
   double* const s = scratch.data();
-#pragma omp parallel for schedule(static) if (n >= MacGeom::kMinCellsForThreads)
+#pragma omp parallel for schedule(static) if (n >= MacStencilGrid::kMinCellsForThreads)
   for (long i = 0; i < n; ++i) s[i] = p[i] + w * (p[i] - q[i]);
   return scratch;
 }
@@ -299,7 +299,7 @@ void NavierStokesSolver::advance(const FluidState& in, double dt, const Array3& 
   ensure_shape(out.p, grid_);
   ensure_shape(out.p_prev, grid_);
 
-  const MacGeom& g = geom_;
+  const MacStencilGrid& g = geom_;
   const double rho = params_.rho, mu = mu_implicit_;
   const double c = mu * dt / (2.0 * rho);  // (I − c ∇_h²) u* = rhs
   const double dt_rho = dt / rho;
@@ -437,7 +437,7 @@ void NavierStokesSolver::prepare_variable(const FluidState& in, double dt, Prepa
 }
 
 IndexBox NavierStokesSolver::variable_stress_box(const Array3& chi) const {
-  const MacGeom& g = geom_;
+  const MacStencilGrid& g = geom_;
   std::array<int, 3> lo = g.n, hi{-1, -1, -1};
   for (int k = 0; k < g.n[2]; ++k)
     for (int j = 0; j < g.n[1]; ++j) {
@@ -471,7 +471,7 @@ IndexBox NavierStokesSolver::variable_stress_box(const Array3& chi) const {
 
 void NavierStokesSolver::add_variable_stress(const FaceField& utilde, const Array3& chi, double dt, int d,
                                              const IndexBox& box) {
-  const MacGeom& g = geom_;
+  const MacStencilGrid& g = geom_;
   const double c = dt / params_.rho * params_.mu;
   Array3& rhs = ustar_[d];
   const int i0 = std::max(box.begin[0], g.first(d, 0)), j0 = std::max(box.begin[1], g.first(d, 1)),

@@ -13,7 +13,7 @@
 // Eq. (13) as printed, p^{n−1/2} + φ − (μ/2ρ) D u*, is dimensionally inconsistent (μ D u / ρ is not a pressure);
 // with φ scaled as in (11) the pressure update of Brown–Cortez–Minion (2001) is the one used here.
 // (9) is three Helmholtz problems (I − (μΔt/2ρ) ∇_h²) u*_d = rhs_d and (11) one Poisson problem; all four are
-// solved directly by FastSolver. Since G is applied only at interior faces and ∇_h² for φ is D G with G φ = 0 on
+// solved directly by FftHelmholtzSolver. Since G is applied only at interior faces and ∇_h² for φ is D G with G φ = 0 on
 // walls, D u^{n+1} = 0 to round-off.
 //
 // The pressure of (9) (FluidParams::pressure). As printed, p^{n−1/2}, half a step behind t^{n+1/2}: where the fluid
@@ -53,10 +53,10 @@
 #include <cstdint>
 #include <memory>
 
-#include "immerse/fluid/FastSolver.hpp"
+#include "immerse/fluid/FftHelmholtzSolver.hpp"
 #include "immerse/fluid/FluidParams.hpp"
 #include "immerse/fluid/FluidState.hpp"
-#include "immerse/fluid/MacGeom.hpp"
+#include "immerse/fluid/MacStencilGrid.hpp"
 
 namespace immerse {
 
@@ -129,12 +129,12 @@ class NavierStokesSolver {
   void apply_wall_values(FaceField& u) const;
 
   /// The fast solver of a layout (three velocity components and the pressure).
-  FastSolver& fast_solver(Layout layout) { return *solvers_[static_cast<int>(layout)]; }
+  FftHelmholtzSolver& fast_solver(Layout layout) { return *solvers_[static_cast<int>(layout)]; }
 
  private:
   Grid grid_;
   FluidParams params_;
-  MacGeom geom_;
+  MacStencilGrid geom_;
   bool matches_grid(const FaceField& f) const;
   void check(const FluidState& in, double dt) const;  // dt > 0 (InputError), `in` on the grid
   void check_force(const FaceField& force) const;
@@ -155,10 +155,10 @@ class NavierStokesSolver {
   /// ũ and (μ_p − μ) ∇_h²(u^n/2 − ũ) added to the explicit terms of `prepared`.
   void prepare_variable(const FluidState& in, double dt, PreparedStep& prepared) const;
 
-  MacGeom geom0_;        // homogeneous walls: the part of ∇_h² that the remainder of a variable viscosity takes
+  MacStencilGrid geom0_;        // homogeneous walls: the part of ∇_h² that the remainder of a variable viscosity takes
   double mu_implicit_;   // μ_p (μ without a variable viscosity)
   PreparedStep own_;     // the one-pass step's preparation, with a variable viscosity
-  std::array<std::unique_ptr<FastSolver>, 4> solvers_;
+  std::array<std::unique_ptr<FftHelmholtzSolver>, 4> solvers_;
   FaceField ustar_;  // u*, then u^{n+1}
   Array3 div_;       // D u*
   Array3 phi_;       // pressure increment φ^{n+1}

@@ -4,7 +4,7 @@
 #include <string>
 
 #include "immerse/core/Error.hpp"
-#include "immerse/fluid/FastSolver.hpp"
+#include "immerse/fluid/FftHelmholtzSolver.hpp"
 
 namespace immerse {
 
@@ -24,7 +24,7 @@ void set_poiseuille_flow(const Grid& grid, const FluidParams& params, FaceField&
   for (int d = 0; d < 3; ++d) {
     auto& v = u[d].values();
     std::fill(v.begin(), v.end(), -params.body_force[d]);
-    if (params.body_force[d] != 0.0) FastSolver(grid, velocity_layout(d), FftPlanning::Estimate).solve(u[d], 0.0, params.mu);
+    if (params.body_force[d] != 0.0) FftHelmholtzSolver(grid, velocity_layout(d), FftPlanning::Estimate).solve(u[d], 0.0, params.mu);
   }
 }
 

@@ -13,32 +13,32 @@
 // Verified by: the tests ViscosityContrast.StressOfConstantViscosityIsTheLaplacian,
 // ViscosityContrast.ManufacturedFlowIsSecondOrderInSpaceAndTime and ViscosityContrast.ManufacturedFlowInAClosedBox*.
 #include "immerse/core/Array3.hpp"
-#include "immerse/fluid/MacGeom.hpp"
+#include "immerse/fluid/MacStencilGrid.hpp"
 #include "immerse/fluid/MacStencil_K.hpp"
 #include "immerse/grid/FaceField.hpp"
 
 namespace immerse::mac {
 
 /// q shifted by s along axis a (wrapped on a periodic axis).
-inline Index shifted(const MacGeom& g, Index q, int a, int s) {
+inline Index shifted(const MacStencilGrid& g, Index q, int a, int s) {
   q[a] += s;
   if (g.periodic[a]) q[a] = wrap(q[a], g.n[a]);
   return q;
 }
 
 /// χ at the d-e edge q: the mean of its four cells.
-inline double edge_chi(const Array3& chi, const MacGeom& g, const Index& q, int d, int e) {
+inline double edge_chi(const Array3& chi, const MacStencilGrid& g, const Index& q, int d, int e) {
   const Index qd = shifted(g, q, d, -1);
   return 0.25 * (at(chi, q) + at(chi, qd) + at(chi, shifted(g, q, e, -1)) + at(chi, shifted(g, qd, e, -1)));
 }
 
 /// S_de at the d-e edge q (e ≠ d).
-inline double edge_strain(const FaceField& u, const MacGeom& g, const Index& q, int d, int e) {
+inline double edge_strain(const FaceField& u, const MacStencilGrid& g, const Index& q, int d, int e) {
   return (at(u[d], q) - at(u[d], shifted(g, q, e, -1)) + at(u[e], q) - at(u[e], shifted(g, q, d, -1))) * g.inv_h;
 }
 
 /// [∇_h·(χ (∇_h u + ∇_h uᵀ))]_d at face q of component d (see the header comment).
-inline double stress_divergence(const FaceField& u, const Array3& chi, const MacGeom& g, int d, const Index& q) {
+inline double stress_divergence(const FaceField& u, const Array3& chi, const MacStencilGrid& g, int d, const Index& q) {
   const Index qm = shifted(g, q, d, -1), qp = shifted(g, q, d, +1);
   const double s_here = 2.0 * (at(u[d], qp) - at(u[d], q)) * g.inv_h;
   const double s_back = 2.0 * (at(u[d], q) - at(u[d], qm)) * g.inv_h;

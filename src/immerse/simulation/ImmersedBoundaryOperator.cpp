@@ -12,7 +12,7 @@
 
 #include "immerse/core/Error.hpp"
 #include "immerse/core/Parallel.hpp"
-#include "immerse/fluid/MacGeom.hpp"
+#include "immerse/fluid/MacStencilGrid.hpp"
 #include "immerse/coupling/NodeDiagnostics.hpp"
 #include "immerse/timestep/LogEvent.hpp"
 
@@ -54,7 +54,7 @@ void blend(const Grid& g, double theta, const FaceField& a, const FaceField& b, 
     auto& o = out[d];
     const auto& x = a[d];
     const auto& y = b[d];
-#pragma omp parallel for if (MacGeom(g).threaded())
+#pragma omp parallel for if (MacStencilGrid(g).threaded())
     for (std::size_t i = 0; i < o.size(); ++i) o[i] = theta * x[i] + (1.0 - theta) * y[i];
   }
 }

@@ -24,7 +24,7 @@
 #include <string>
 
 #include "immerse/fluid/ExactSolutions.hpp"
-#include "immerse/fluid/FastSolver.hpp"
+#include "immerse/fluid/FftHelmholtzSolver.hpp"
 #include "immerse/fluid/FluidDiagnostics.hpp"
 #include "immerse/fluid/NavierStokesSolver.hpp"
 #include "immerse/verify/Convergence.hpp"
@@ -206,7 +206,7 @@ std::vector<Check> fluid_solvers(bool quick) {
       std::array<Boundary, 3> bc{};
       for (int a = 0; a < 3; ++a) bc[a] = (combo >> a) & 1 ? W : P;
       const Grid g({6 * m, 10 * m, 8 * m}, {0.6, 1.0, 0.8}, bc);
-      FastSolver solver(g, layout, FftPlanning::Estimate);
+      FftHelmholtzSolver solver(g, layout, FftPlanning::Estimate);
       const auto shape = layout == Layout::Pressure ? g.cell_shape() : g.face_shape(l);
       Array3 x(shape[0], shape[1], shape[2]);
       for (double& v : x.values()) v = U(rng);
@@ -374,7 +374,7 @@ std::vector<Check> duct_poiseuille(bool quick) {
   // Discrete steady solution directly: μ ∇_h² u = −G, one transform solve on the u layout.
   const auto steady = [&](const Grid& g) {
     Array3 u(g.face_shape(0)[0], g.face_shape(0)[1], g.face_shape(0)[2], -duct.G / duct.mu);
-    FastSolver(g, Layout::VelocityX, FftPlanning::Estimate).solve(u, 0.0, 1.0);
+    FftHelmholtzSolver(g, Layout::VelocityX, FftPlanning::Estimate).solve(u, 0.0, 1.0);
     return u;
   };
   const std::vector<int> ns = quick ? std::vector<int>{8, 16, 32} : std::vector<int>{16, 32, 64, 128};

@@ -14,13 +14,13 @@
 // factors 1/(α + β Σλ) are tabulated for the last (α, β) (a time step changes them; the step after uses the table).
 //
 // One in-place 3D r2r plan pair per solver, created once (see FftPlanning); at or above
-// MacGeom::kMinCellsForThreads unknowns a second pair for omp_get_max_threads() (at construction) FFTW threads,
+// MacStencilGrid::kMinCellsForThreads unknowns a second pair for omp_get_max_threads() (at construction) FFTW threads,
 // executed whenever OpenMP's thread count is above one when solve() is called (ThreadGovernor may change it). The plans work
 // on an internal buffer (the unknowns copied in and out), or, for a solver made for one array whose unknowns are
 // the whole array (every layout but a face-normal component on a wall axis), on that array itself. Not reentrant.
 // A distributed (FFTW-MPI) backend can replace this class behind the same solve().
 // Verified by: the study fluid_solvers (residual of every Helmholtz/Poisson solve, every layout and boundary
-// combination, ≤ 1e-11) and the tests FastSolver.* (the tabulated eigenvectors, a manufactured Helmholtz solution).
+// combination, ≤ 1e-11) and the tests FftHelmholtzSolver.* (the tabulated eigenvectors, a manufactured Helmholtz solution).
 #include <array>
 #include <limits>
 #include <vector>
@@ -43,15 +43,15 @@ enum class Layout { VelocityX = 0, VelocityY = 1, VelocityZ = 2, Pressure = 3 };
 
 inline Layout velocity_layout(int d) { return static_cast<Layout>(d); }
 
-class FastSolver {
+class FftHelmholtzSolver {
  public:
   /// With `in_place`, a solver that only ever solves in that array (whose values planning may overwrite): it
   /// transforms the array itself when its unknowns are the whole array, saving two copies per solve.
-  FastSolver(const Grid& grid, Layout layout, FftPlanning planning = FftPlanning::Measure,
+  FftHelmholtzSolver(const Grid& grid, Layout layout, FftPlanning planning = FftPlanning::Measure,
              Array3* in_place = nullptr);
-  ~FastSolver();
-  FastSolver(const FastSolver&) = delete;
-  FastSolver& operator=(const FastSolver&) = delete;
+  ~FftHelmholtzSolver();
+  FftHelmholtzSolver(const FftHelmholtzSolver&) = delete;
+  FftHelmholtzSolver& operator=(const FftHelmholtzSolver&) = delete;
 
   /// Overwrites the unknowns of x (shape of the layout: face_shape(d) or cell_shape) with the solution of
   /// (α I + β ∇_h²) x = b, b being the values of x on entry. Wall faces of a face-normal layout are untouched.

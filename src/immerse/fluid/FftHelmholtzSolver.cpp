@@ -1,4 +1,4 @@
-#include "immerse/fluid/FastSolver.hpp"
+#include "immerse/fluid/FftHelmholtzSolver.hpp"
 
 #include <fftw3.h>
 #include <omp.h>
@@ -8,7 +8,7 @@
 #include <numbers>
 #include <stdexcept>
 
-#include "immerse/fluid/MacGeom.hpp"
+#include "immerse/fluid/MacStencilGrid.hpp"
 
 namespace immerse {
 
@@ -25,7 +25,7 @@ void init_fftw_threads() {
 
 }  // namespace
 
-FastSolver::FastSolver(const Grid& grid, Layout layout, FftPlanning planning, Array3* in_place) : layout_(layout) {
+FftHelmholtzSolver::FftHelmholtzSolver(const Grid& grid, Layout layout, FftPlanning planning, Array3* in_place) : layout_(layout) {
   init_fftw_threads();
   const int comp = static_cast<int>(layout);  // 3: pressure
   const double h = grid.h();
@@ -65,7 +65,7 @@ FastSolver::FastSolver(const Grid& grid, Layout layout, FftPlanning planning, Ar
     }
   }
   const std::size_t total = static_cast<std::size_t>(m_[0]) * m_[1] * m_[2];
-  threaded_ = static_cast<long>(total) >= MacGeom::kMinCellsForThreads;
+  threaded_ = static_cast<long>(total) >= MacStencilGrid::kMinCellsForThreads;
   const bool whole = lo_ == std::array<int, 3>{0, 0, 0};  // the unknowns are the whole array
   if (in_place && whole && in_place->nx() == m_[0] && in_place->ny() == m_[1] && in_place->nz() == m_[2]) {
     target_ = in_place;
@@ -89,7 +89,7 @@ FastSolver::FastSolver(const Grid& grid, Layout layout, FftPlanning planning, Ar
   }
 }
 
-FastSolver::~FastSolver() {
+FftHelmholtzSolver::~FftHelmholtzSolver() {
   for (int t = 0; t < 2; ++t) {
     if (forward_[t]) fftw_destroy_plan(forward_[t]);
     if (backward_[t]) fftw_destroy_plan(backward_[t]);
@@ -97,9 +97,9 @@ FastSolver::~FastSolver() {
   if (buf_) fftw_free(buf_);
 }
 
-int FastSolver::plan_index() const { return forward_[1] != nullptr && omp_get_max_threads() > 1 ? 1 : 0; }
+int FftHelmholtzSolver::plan_index() const { return forward_[1] != nullptr && omp_get_max_threads() > 1 ? 1 : 0; }
 
-void FastSolver::set_symbol(double alpha, double beta) {
+void FftHelmholtzSolver::set_symbol(double alpha, double beta) {
   const int mx = m_[0], my = m_[1], mz = m_[2];
   const double* lx = lambda_[0].data();
   const double* ly = lambda_[1].data();
@@ -119,11 +119,11 @@ void FastSolver::set_symbol(double alpha, double beta) {
   beta_ = beta;
 }
 
-void FastSolver::solve(Array3& x, double alpha, double beta) {
+void FftHelmholtzSolver::solve(Array3& x, double alpha, double beta) {
   const int mx = m_[0], my = m_[1], mz = m_[2];
   const int ox = lo_[0], oy = lo_[1], oz = lo_[2];
   double* const b = data_;
-  if (target_ && &x != target_) throw std::logic_error("FastSolver::solve: this solver works in place on another array");
+  if (target_ && &x != target_) throw std::logic_error("FftHelmholtzSolver::solve: this solver works in place on another array");
   if (!target_) {
 #pragma omp parallel for collapse(2) schedule(static) if (threaded_)
     for (int k = 0; k < mz; ++k)
@@ -145,7 +145,7 @@ void FastSolver::solve(Array3& x, double alpha, double beta) {
       for (int i = 0; i < mx; ++i) x(i + ox, j + oy, k + oz) = b[i + mx * (j + my * static_cast<std::size_t>(k))];
 }
 
-void FastSolver::transform_round_trip() {
+void FftHelmholtzSolver::transform_round_trip() {
   const int t = plan_index();
   fftw_execute(forward_[t]);
   fftw_execute(backward_[t]);

@@ -15,7 +15,7 @@
 
 namespace immerse {
 
-struct MacGeom {
+struct MacStencilGrid {
   std::array<int, 3> n{};
   std::array<bool, 3> periodic{};
   double h = 1;
@@ -24,10 +24,10 @@ struct MacGeom {
   std::array<Vec3, 3> wall_upper{};
 
   /// Homogeneous walls (all wall velocities zero): the operators the fast solvers invert.
-  explicit MacGeom(const Grid& g) : n(g.n()), h(g.h()), inv_h(1 / g.h()), inv_h2(1 / (g.h() * g.h())) {
+  explicit MacStencilGrid(const Grid& g) : n(g.n()), h(g.h()), inv_h(1 / g.h()), inv_h2(1 / (g.h() * g.h())) {
     for (int a = 0; a < 3; ++a) periodic[a] = g.periodic(a);
   }
-  MacGeom(const Grid& g, const FluidParams& p) : MacGeom(g) {
+  MacStencilGrid(const Grid& g, const FluidParams& p) : MacStencilGrid(g) {
     wall_lower = p.wall_lower;
     wall_upper = p.wall_upper;
   }
@@ -49,7 +49,7 @@ struct MacGeom {
 
 /// Calls f(i, j, k) for every unknown of velocity component d (OpenMP over the two outer axes).
 template <class F>
-void for_each_face(const MacGeom& g, int d, F&& f) {
+void for_each_face(const MacStencilGrid& g, int d, F&& f) {
   const int i0 = g.first(d, 0), j0 = g.first(d, 1), k0 = g.first(d, 2);
 #pragma omp parallel for collapse(2) schedule(static) if (g.threaded())
   for (int k = k0; k < g.n[2]; ++k)
@@ -67,7 +67,7 @@ struct IndexBox {
 /// point() alone (the generic kernels). OpenMP over the two outer axes, like for_each_face. `fast` must lie
 /// inside `all`.
 template <class Point, class Row>
-void for_each_split(const MacGeom& g, const IndexBox& all, const IndexBox& fast, Point&& point, Row&& row) {
+void for_each_split(const MacStencilGrid& g, const IndexBox& all, const IndexBox& fast, Point&& point, Row&& row) {
   const int i0 = all.begin[0], i1 = all.end[0];
   const int f0 = fast.begin[0], f1 = fast.end[0];
   const bool x_fast = f0 < f1;
@@ -88,18 +88,18 @@ void for_each_split(const MacGeom& g, const IndexBox& all, const IndexBox& fast,
 
 /// Calls row(j, k, box.begin[0], box.end[0]) for every row of the box (OpenMP over the two outer axes).
 template <class Row>
-void for_each_row(const MacGeom& g, const IndexBox& box, Row&& row) {
+void for_each_row(const MacStencilGrid& g, const IndexBox& box, Row&& row) {
 #pragma omp parallel for collapse(2) schedule(static) if (g.threaded())
   for (int k = box.begin[2]; k < box.end[2]; ++k)
     for (int j = box.begin[1]; j < box.end[1]; ++j) row(j, k, box.begin[0], box.end[0]);
 }
 
 /// The unknowns of velocity component d, and among them those where the row kernels apply
-/// (MacGeom::interior_begin/end).
-inline IndexBox face_box(const MacGeom& g, int d) {
+/// (MacStencilGrid::interior_begin/end).
+inline IndexBox face_box(const MacStencilGrid& g, int d) {
   return {{g.first(d, 0), g.first(d, 1), g.first(d, 2)}, g.n};
 }
-inline IndexBox interior_face_box(const MacGeom& g, int d) {
+inline IndexBox interior_face_box(const MacStencilGrid& g, int d) {
   IndexBox b = face_box(g, d);
   for (int a = 0; a < 3; ++a) {
     b.begin[a] = std::clamp(g.interior_begin(d, a), b.begin[a], b.end[a]);
@@ -110,7 +110,7 @@ inline IndexBox interior_face_box(const MacGeom& g, int d) {
 
 /// Calls f(i, j, k) for every cell.
 template <class F>
-void for_each_cell(const MacGeom& g, F&& f) {
+void for_each_cell(const MacStencilGrid& g, F&& f) {
 #pragma omp parallel for collapse(2) schedule(static) if (g.threaded())
   for (int k = 0; k < g.n[2]; ++k)
     for (int j = 0; j < g.n[1]; ++j)
