@@ -61,6 +61,31 @@ struct VariableViscosityMms {
 };
 
 
+/// The state after two steps of dt taken exactly from the manufactured flow `mms` (velocity(x, t), pressure(x, t)):
+/// u^0, p^{-1/2}, and the history u^{-1} (the extrapolation of the viscous remainder), p^{-3/2} and
+/// (u·∇_h u)^{-1}, so that every step is the scheme's second-order one (a start-up step is first order locally).
+template <class Mms>
+FluidState exact_start(const NavierStokesSolver& ns, const Mms& mms, double dt) {
+  const Grid& grid = ns.grid();
+  FluidState a = ns.initial_state();
+  sample_velocity(grid, [&](const Vec3& x) { return mms.velocity(x, 0.0); }, a.u);
+  ns.apply_wall_values(a.u);
+  sample_pressure(grid, [&](const Vec3& x) { return mms.pressure(x, -0.5 * dt); }, a.p);
+  a.u_prev = FaceField(grid);
+  sample_velocity(grid, [&](const Vec3& x) { return mms.velocity(x, -dt); }, a.u_prev);
+  ns.apply_wall_values(a.u_prev);
+  sample_pressure(grid, [&](const Vec3& x) { return mms.pressure(x, -1.5 * dt); }, a.p_prev);
+  const MacStencilGrid g(grid, ns.params());
+  for (int d = 0; d < 3; ++d)
+    for_each_face(g, d, [&](int i, int j, int k) {
+      const mac::Index q{i, j, k};
+      a.adv[d](i, j, k) = mac::advection_face(a.u_prev, g, d, q, mac::gather(a.u_prev[d], g, d, q));
+    });
+  a.dt_prev = a.dt_prev2 = dt;
+  a.step = 2;
+  return a;
+}
+
 /// The state after `steps` steps of dt from the exact u(0), p(−Δt/2), and (into p_before_last) p one step before.
 FluidState integrate(const VariableViscosityMms& mms, int n, double dt, int steps, Array3* p_before_last = nullptr) {
   const Grid grid({n, n, n}, {2 * pi, 2 * pi, 2 * pi}, {P, P, P});
@@ -71,22 +96,7 @@ FluidState integrate(const VariableViscosityMms& mms, int n, double dt, int step
   prm.variable_viscosity = true;
   prm.implicit_ratio = 1.5;  // max μ / μ0
   NavierStokesSolver ns(grid, prm, FftPlanning::Estimate);
-  FluidState a = ns.initial_state(), b;
-  sample_velocity(grid, [&](const Vec3& x) { return mms.velocity(x, 0.0); }, a.u);
-  sample_pressure(grid, [&](const Vec3& x) { return mms.pressure(x, -0.5 * dt); }, a.p);
-  // The exact history of a state after two steps: u^{-1} (the extrapolation of the viscous remainder), p^{-3/2} and
-  // (u·∇_h u)^{-1}, so that every step is the scheme's second-order one (a start-up step is first order locally).
-  a.u_prev = FaceField(grid);
-  sample_velocity(grid, [&](const Vec3& x) { return mms.velocity(x, -dt); }, a.u_prev);
-  sample_pressure(grid, [&](const Vec3& x) { return mms.pressure(x, -1.5 * dt); }, a.p_prev);
-  const MacStencilGrid g(grid);
-  for (int d = 0; d < 3; ++d)
-    for_each_face(g, d, [&](int i, int j, int k) {
-      const mac::Index q{i, j, k};
-      a.adv[d](i, j, k) = mac::advection_face(a.u_prev, g, d, q, mac::gather(a.u_prev[d], g, d, q));
-    });
-  a.dt_prev = a.dt_prev2 = dt;
-  a.step = 2;
+  FluidState a = exact_start(ns, mms, dt), b;
   Array3 chi(n, n, n);
   sample_pressure(grid, [&](const Vec3& x) { return mms.chi(x); }, chi);
   FaceField shape(grid), stress(grid), force(grid);
@@ -147,22 +157,7 @@ std::pair<double, double> closed_box_errors(int n) {
   const double T = 0.25;
   const int steps = static_cast<int>(std::ceil(T / (0.2 * grid.h())));
   const double dt = T / steps;
-  FluidState a = ns.initial_state(), b;
-  sample_velocity(grid, [&](const Vec3& x) { return mms.velocity(x, 0.0); }, a.u);
-  ns.apply_wall_values(a.u);
-  sample_pressure(grid, [&](const Vec3& x) { return mms.pressure(x, -0.5 * dt); }, a.p);
-  a.u_prev = FaceField(grid);
-  sample_velocity(grid, [&](const Vec3& x) { return mms.velocity(x, -dt); }, a.u_prev);
-  ns.apply_wall_values(a.u_prev);
-  sample_pressure(grid, [&](const Vec3& x) { return mms.pressure(x, -1.5 * dt); }, a.p_prev);
-  const MacStencilGrid g(grid, prm);
-  for (int d = 0; d < 3; ++d)
-    for_each_face(g, d, [&](int i, int j, int k) {
-      const mac::Index q{i, j, k};
-      a.adv[d](i, j, k) = mac::advection_face(a.u_prev, g, d, q, mac::gather(a.u_prev[d], g, d, q));
-    });
-  a.dt_prev = a.dt_prev2 = dt;
-  a.step = 2;
+  FluidState a = exact_start(ns, mms, dt), b;
   Array3 chi(n, n, n);
   sample_pressure(grid, bump, chi);
   std::array<FaceField, 5> parts;
