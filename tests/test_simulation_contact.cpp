@@ -139,6 +139,41 @@ TEST(ContactForce, CellListSearchEqualsBruteForceWithPeriodicImages) {
   }
 }
 
+// Compact "membranes" (balls of nodes) at random centres, some beyond the periodic ends and one wrapped node by node:
+// the bounding-box test that skips far membranes must find exactly the pairs of the brute-force search.
+TEST(ContactForce, BoundingBoxesKeepEveryPairOfCompactMembranes) {
+  const Grid grid{{8, 10, 6}, {8.0, 10.0, 6.0}, {P, P, W}};
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> U(0, 1);
+  std::vector<std::size_t> offsets{0};
+  std::vector<Vec3> X;
+  for (int m = 0; m < 14; ++m) {
+    const Vec3 centre{9 * U(rng) - 0.5, 11 * U(rng) - 0.5, 1 + 4 * U(rng)};
+    for (int n = 0; n < 30; ++n) {
+      Vec3 x = centre + Vec3{U(rng) - 0.5, U(rng) - 0.5, U(rng) - 0.5} * 1.4;
+      if (m == 13) x[0] -= 8 * std::floor(x[0] / 8);  // each node wrapped into [0, 8)
+      X.push_back(x);
+    }
+    offsets.push_back(X.size());
+  }
+  const auto membrane = [&](std::size_t n) {
+    return std::upper_bound(offsets.begin(), offsets.end(), n) - offsets.begin();
+  };
+  for (double range : {0.3, 1.0}) {
+    ContactForce contact(grid, {range, 1.0, false}, offsets, std::vector<double>(offsets.size() - 1, 1.0));
+    const auto fast = contact.neighbours(X);
+    std::size_t pairs = 0;
+    for (std::size_t i = 0; i < X.size(); ++i) {
+      std::vector<std::size_t> slow;
+      for (std::size_t j = 0; j < X.size(); ++j)
+        if (membrane(j) != membrane(i) && norm(minimum_image(grid, X[i], X[j])) < range) slow.push_back(j);
+      EXPECT_EQ(fast[i], slow) << "range " << range << ", node " << i;
+      pairs += slow.size();
+    }
+    EXPECT_GT(pairs, 0u) << "range " << range;
+  }
+}
+
 TEST(ContactForce, RangeMustBeBelowHalfThePeriodicLength) {
   const Grid g({10, 10, 10}, {1.0, 1.0, 1.0}, {P, W, W});
   EXPECT_THROW(ContactForce(g, {0.5, 1.0, true}, {0, 1}, {1.0}), InputError);

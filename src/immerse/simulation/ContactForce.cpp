@@ -43,6 +43,38 @@ std::array<long, 3> ContactForce::bin_coords(const Vec3& p) const {
 }
 
 void ContactForce::bin(std::span<const Vec3> X) {
+  // Broad phase: nodes i of a and j of b within d by minimum image need |c_a - c_b| < s_a + s_b + d on every axis
+  // (c the box centre, s its half-width, the difference wrapped into half a period when s_a + s_b + d is below it),
+  // and |c_a - c_b| < R_a + R_b + d by minimum image (R the largest distance of a node from c).
+  const std::size_t membranes = offsets_.size() - 1;
+  std::vector<Vec3> centre(membranes), half(membranes);
+  std::vector<double> radius(membranes, 0.0);
+  for (std::size_t m = 0; m < membranes; ++m) {
+    Vec3 lo = X[offsets_[m]], hi = lo;
+    for (std::size_t i = offsets_[m]; i < offsets_[m + 1]; ++i)
+      for (int k = 0; k < 3; ++k) lo[k] = std::min(lo[k], X[i][k]), hi[k] = std::max(hi[k], X[i][k]);
+    centre[m] = 0.5 * (lo + hi);
+    half[m] = 0.5 * (hi - lo);
+    for (std::size_t i = offsets_[m]; i < offsets_[m + 1]; ++i) radius[m] = std::max(radius[m], norm(X[i] - centre[m]));
+  }
+  const double d = settings_.range;
+  touching_.assign(membranes, 0);
+  for (std::size_t a = 0; a < membranes; ++a)
+    for (std::size_t b = a + 1; b < membranes; ++b) {
+      bool overlap = norm(minimum_image(grid_, centre[a], centre[b])) < radius[a] + radius[b] + d;
+      for (int k = 0; k < 3 && overlap; ++k) {
+        const double reach = half[a][k] + half[b][k] + d;
+        double gap = centre[a][k] - centre[b][k];
+        if (grid_.periodic(k)) {
+          const double L = grid_.length(k);
+          if (reach >= 0.5 * L) continue;  // the boxes may meet through either image
+          gap -= L * std::round(gap / L);
+        }
+        overlap = std::abs(gap) < reach;
+      }
+      if (overlap) touching_[a] = touching_[b] = 1;
+    }
+  if (std::ranges::find(touching_, char{1}) == touching_.end()) return;  // no node has a neighbour: no bins needed
   // Bins of at least d; fewer (larger) ones where the box holds many more bins than nodes.
   const long limit = 27 + 8 * static_cast<long>(X.size());
   for (int k = 0; k < 3; ++k) nb_[k] = std::max(1L, static_cast<long>(std::floor(grid_.length(k) / settings_.range)));
@@ -55,18 +87,21 @@ void ContactForce::bin(std::span<const Vec3> X) {
   node_bin_.resize(X.size());
   start_.assign(bins + 1, 0);
   for (std::size_t i = 0; i < X.size(); ++i) {
+    if (!touching_[membrane_of_[i]]) continue;
     const auto c = bin_coords(X[i]);
     node_bin_[i] = static_cast<std::size_t>((c[2] * nb_[1] + c[1]) * nb_[0] + c[0]);
     ++start_[node_bin_[i] + 1];
   }
   for (std::size_t b = 0; b < bins; ++b) start_[b + 1] += start_[b];
-  sorted_.resize(X.size());
-  std::vector<std::size_t> next(start_.begin(), start_.end() - 1);
-  for (std::size_t i = 0; i < X.size(); ++i) sorted_[next[node_bin_[i]]++] = i;
+  sorted_.resize(start_[bins]);
+  next_.assign(start_.begin(), start_.end() - 1);
+  for (std::size_t i = 0; i < X.size(); ++i)
+    if (touching_[membrane_of_[i]]) sorted_[next_[node_bin_[i]]++] = i;
 }
 
 template <class F>
 void ContactForce::for_each_neighbour(std::span<const Vec3> X, std::size_t i, F&& f) const {
+  if (!touching_[membrane_of_[i]]) return;  // no other membrane within reach of its box
   const double d = settings_.range;
   const std::size_t b = node_bin_[i];
   const std::array<long, 3> c{static_cast<long>(b) % nb_[0], static_cast<long>(b) / nb_[0] % nb_[1],

@@ -21,8 +21,9 @@
 // The law is the soft repulsion of dissipative particle dynamics, F = a (1 - r/d) (Groot & Warren, J. Chem. Phys.
 // 107, 4423 (1997)), squared for a continuous derivative at r = d.
 //
-// Neighbour search: a cell list of bins no smaller than d (at most a few per node, so memory and cost are linear in
-// the nodes), rebuilt at every evaluation. Each node sums the forces of its own neighbours in a fixed order (bins,
+// Neighbour search: first the membranes' bounding boxes (a pair can touch only if its boxes, grown by d, overlap by
+// minimum image), then a cell list of bins no smaller than d holding the nodes of the membranes that can touch (at
+// most a few per node, so memory and cost are linear in the nodes), rebuilt at every evaluation. Each node sums the forces of its own neighbours in a fixed order (bins,
 // then node index): the sums do not depend on the thread count. With no node within d of another membrane or a
 // wall every force is exactly zero, and the run is bitwise that without contact.
 // Verified by tests/test_simulation_contact.cpp (ContactForce.*: gradient, support, third law, walls, neighbour
@@ -71,8 +72,11 @@ class ContactForce {
   }
 
  private:
-  /// Sorts the nodes into bins (counting sort: ascending node index within a bin).
+  /// Marks the membranes whose bounding box, grown by d, overlaps another's, and sorts their nodes into bins
+  /// (counting sort: ascending node index within a bin); the other nodes have no neighbours.
   void bin(std::span<const Vec3> X);
+  /// Whether membrane `m` has a bounding box within d of another's (set by bin()).
+  bool may_touch(std::size_t m) const { return touching_[m] != 0; }
   std::array<long, 3> bin_coords(const Vec3& p) const;
   /// f(j, X_i - X_j by minimum image, r) for each node j of another membrane within d of node i, in a fixed order.
   template <class F>
@@ -89,6 +93,8 @@ class ContactForce {
   std::array<long, 3> nb_{};              ///< bins along each axis
   std::array<double, 3> size_{};          ///< bin size along each axis (>= d)
   std::vector<std::size_t> node_bin_, start_, sorted_;  ///< bin of each node; bin b holds sorted_[start_[b] .. start_[b+1])
+  std::vector<std::size_t> next_;                       ///< bin() work: next free slot of each bin
+  std::vector<char> touching_;                          ///< per membrane: may touch another (bin())
 };
 
 }  // namespace immerse
