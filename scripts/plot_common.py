@@ -92,7 +92,13 @@ def label_of(cfg, run_dir):
         return ", ".join(parts)
     if kind == "oscillating_membrane":
         return f"$\\mu$ = {cfg['fluid']['mu']:g}"
-    if kind in ("rbc_stretch", "rbc_channel"):
+    if kind == "rbc_stretch":  # the sweeps of Fig. 13 differ in modulus, area constraint and size
+        label = f"$\\mu_0$ = {sc['mu0'] * 1e6:g} $\\mu$N/m"
+        k_A = cfg["membrane"][0].get("area_modulus", 0.0)
+        if k_A > 0:
+            label += f", area modulus {k_A * 1e3:g} mN/m"
+        return f"{label} ({resolution_of(cfg)})"
+    if kind == "rbc_channel":
         return f"$\\mu_0$ = {sc['mu0'] * 1e6:g} $\\mu$N/m"
     return os.path.basename(os.path.normpath(run_dir))
 

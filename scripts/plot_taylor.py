@@ -7,11 +7,14 @@ Runs of the shear scenarios capsule_shear (Fig. 7), oblate_shear (Figs. 8-9) and
 run's config.resolved.toml: the shear rate k = (boundary.z_upper_velocity[0] - boundary.z_lower_velocity[0]) /
 domain.Lz and the legend (scenario.G; scenario.aspect_ratio = b/a for oblate_shear; scenario.kappa_B_hat for
 bending_shear). Each capsule_shear run gets the small-deformation theory D = 25G/4 (docs/theory/conventions.md; initially
-spherical neo-Hookean capsule without bending, viscosity ratio 1) as a dashed line of its colour; the theory does
+spherical neo-Hookean capsule without bending, viscosity ratio 1) as a dashed line of its colour up to G = 0.05
+(it is printed for every G); the theory does
 not apply to oblate or bending capsules and the paper draws none there. When the runs differ in kappa_B_hat, the
 line width grows with kappa_B_hat, as in Fig. 11. --panel-per-G draws one panel per value of G (Fig. 11 a, b).
 With --theta a second row of panels shows the inclination theta (for capsule_shear against its small-deformation
-value pi/4 - 97G/16). A run that stopped before scenario.kt_end (e.g. an element inverted) says so in the legend.
+value pi/4 - 97G/16). Beside capsule_shear runs the published steady values of scenarios/capsule_shear_published.csv
+(boundary elements, Ramanujan & Pozrikidis 1998, and two immersed-boundary front-tracking codes) are drawn as
+markers at the end of the run, in the run's colour (--no-published leaves them out). A run that stopped before scenario.kt_end (e.g. an element inverted) says so in the legend.
 Runs with the same groups (a refinement study, Fig. 10) are told apart by their grid and node count.
 Default PNG: taylor.png in the first RUN_DIR.
 """
@@ -22,6 +25,27 @@ import matplotlib.pyplot as plt
 import numpy as np
 
 import plot_common as pc
+
+PUBLISHED = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "scenarios", "capsule_shear_published.csv")
+THEORY_G_MAX = 0.05  # the small-deformation lines are drawn up to this G (beyond, 25G/4 is far off the curves)
+METHODS = {  # marker and legend of each method in capsule_shear_published.csv
+    "bem": ("o", "boundary elements (Ramanujan & Pozrikidis 1998)"),
+    "ib_front_tracking": ("s", "IB front tracking (Doddi & Bagchi 2008)"),
+    "adaptive_front_tracking": ("^", "adaptive front tracking (Huet & Wachs 2023)"),
+}
+
+
+def read_published(path):
+    """Rows (G, D_xz, method) of the published steady values."""
+    rows = []
+    with open(path) as f:
+        lines = [line for line in f if line.strip() and not line.startswith("#")]
+    for line in lines[1:]:
+        G, D, method = line.strip().split(",")
+        if method not in METHODS:
+            pc.fail(f"{path}: unknown method {method!r}, expected one of {', '.join(METHODS)}")
+        rows.append((float(G), float(D), method))
+    return rows
 
 TITLES = {
     "capsule_shear": "Initially spherical neo-Hookean capsule in simple shear",
@@ -52,7 +76,10 @@ def main():
     parser.add_argument("--theta", action="store_true", help="add panels with the inclination theta")
     parser.add_argument("--panel-per-G", action="store_true", help="one panel per value of G (Fig. 11 a, b)")
     parser.add_argument("--title", help="figure title (default: from the scenario kind)")
+    parser.add_argument("--no-published", action="store_true",
+                        help="leave out the published steady values beside capsule_shear runs")
     args = parser.parse_args()
+    published = [] if args.no_published else read_published(PUBLISHED)
 
     runs = sorted((read_run(d) for d in args.run_dirs), key=lambda r: (r["G"], -r["ba"], r["kappa"]))
     kinds = sorted({r["kind"] for r in runs})
@@ -68,6 +95,7 @@ def main():
         ax, ax_theta = axes[0][col], (axes[1][col] if args.theta else None)
         members = [r for r in runs if group is None or r["G"] == group]
         theory = False
+        methods_drawn = set()
         for i, r in enumerate(members):
             diag = pc.read_diagnostics(r["dir"])
             kt = r["k"] * diag["time"]
@@ -93,14 +121,23 @@ def main():
             if r["kind"] == "capsule_shear":
                 theory = True
                 G = r["G"]
-                ax.axhline(25.0 * G / 4.0, color=color, ls="--", lw=1)
-                if ax_theta is not None:
+                if G <= THEORY_G_MAX:
+                    ax.axhline(25.0 * G / 4.0, color=color, ls="--", lw=1)
+                if ax_theta is not None and G <= THEORY_G_MAX:
                     ax_theta.axhline(np.pi / 4 - 97.0 * G / 16.0, color=color, ls="--", lw=1)
                 line += (f"; theory 25G/4 = {25 * G / 4:.4f} (ratio {D[-1] / (25 * G / 4):.3f}), "
                          f"pi/4 - 97G/16 = {np.pi / 4 - 97 * G / 16:.4f}")
+                # Published steady values at this G, spread a little along k t so that close values stay visible.
+                here = [p for p in published if abs(p[0] - G) <= 1e-9 * G]
+                for j, (_, Dp, method) in enumerate(here):
+                    ax.plot(kt[-1] * (1.0 - 0.035 * j), Dp, METHODS[method][0], color=color, mfc="none", ms=7)
+                    methods_drawn.add(method)
+                    line += f"; {method} {Dp:.4f} (ours {100 * (D[late].mean() / Dp - 1):+.1f} %)"
             print(line)
         if theory:
             ax.plot([], [], "k--", lw=1, label="small-deformation theory 25G/4")
+        for method in sorted(methods_drawn):
+            ax.plot([], [], METHODS[method][0], color="k", mfc="none", ms=7, label=METHODS[method][1])
         ax.set_xlabel("dimensionless time k t")
         ax.set_ylabel("Taylor parameter $D_{xz}$")
         ax.set_xlim(left=0)
