@@ -1,0 +1,165 @@
+#!/usr/bin/python3
+"""A red blood cell in simple shear: tumbling or tank-treading/swinging, from the orientation of its symmetry axis.
+
+Usage: /usr/bin/python3 scripts/plot_rbc_shear.py RUN_DIR [RUN_DIR ...] [-o PNG] [--title TEXT] [--membrane M]
+Runs of scenarios/rbc_shear.toml or rbc_shear_quick.toml (or any run with a disc-like membrane in the shear flow
+u = (k z, 0, 0) between z walls moving along x), read from the frames fields_NNNNNN.h5. In each frame:
+  - the symmetry axis n of the cell: the principal axis of the membrane surface with the largest moment of inertia
+    (the smallest eigenvalue of the area-weighted second moment S = int (x - c)(x - c)^T dA, c the centroid);
+  - phi, the angle of n in the shear plane x-z from +z towards +x (the sense in which the flow turns a material line),
+    made continuous in time: a tumbling disc advances phi by pi per flip, a swinging one oscillates about a mean
+    (-phi is the inclination of the disc's plane from the flow direction);
+  - psi, the angle in the same plane around the centroid of one material node (the node nearest the rim on the +x
+    side at the first frame), made continuous: psi - phi grows by 2 pi per turn of the membrane around the cell when
+    it tank-treads, and only oscillates when the cell tumbles (the node stays in place on the cell).
+Prints, per run: the number of flips (whole half-turns of phi), the mean and range of phi over the second half of
+the run, and the tank-treading frequency f_tt / k = (change of psi - phi over the second half) / (2 pi k t).
+Left panel: phi / pi against k t; right panel: (psi - phi) / (2 pi), the membrane's turns around the cell.
+Default PNG: rbc_shear.png in the first RUN_DIR.
+"""
+import argparse
+import os
+
+import h5py
+import matplotlib.pyplot as plt
+import numpy as np
+
+import plot_common as pc
+
+# Sub-triangles of a 6-node triangle in terms of its local nodes 0, 1, 2 (vertices), 3 = 01, 4 = 12, 5 = 20.
+SUB_TRIANGLES = np.array([[0, 3, 5], [3, 1, 4], [5, 4, 2], [3, 4, 5]])
+
+
+def read_frame(path, membrane):
+    """(time, nodes [N,3], linear triangles [4T,3]) of one membrane in one frame."""
+    with h5py.File(path, "r") as f:
+        if "membranes" not in f:
+            pc.fail(f"{path} has no membranes")
+        g = f["membranes"]
+        offsets, ids = g["node_offsets"][()], g["membrane_id"][()]
+        if not 0 <= membrane < len(offsets) - 1:
+            pc.fail(f"--membrane {membrane}: {path} has {len(offsets) - 1} membrane(s)")
+        nodes = g["nodes"][()][offsets[membrane]:offsets[membrane + 1]]
+        conn = g["connectivity"][()][ids == membrane] - offsets[membrane]
+        return float(f.attrs["time"]), nodes, conn[:, SUB_TRIANGLES].reshape(-1, 3)
+
+
+def surface_moments(nodes, tris):
+    """(area-weighted centroid c, second moment S = int (x - c)(x - c)^T dA) of a triangulated surface (exact for
+    flat triangles)."""
+    v = nodes[tris]  # [T, 3 vertices, 3]
+    area = 0.5 * np.linalg.norm(np.cross(v[:, 1] - v[:, 0], v[:, 2] - v[:, 0]), axis=1)
+    total = area.sum()
+    c = (area[:, None] * v.mean(axis=1)).sum(axis=0) / total
+    w = v - c
+    s = w.sum(axis=1)
+    # int over a flat triangle of x x^T dA = A/12 (sum_i v_i v_i^T + (sum_i v_i)(sum_i v_i)^T)
+    second = np.einsum("t,tij,tik->jk", area, w, w) + np.einsum("t,tj,tk->jk", area, s, s)
+    return c, second / 12.0
+
+
+def symmetry_axis(nodes, tris):
+    """(centroid, unit symmetry axis): the eigenvector of the smallest eigenvalue of S (largest moment of inertia)."""
+    c, second = surface_moments(nodes, tris)
+    values, vectors = np.linalg.eigh(second)
+    return c, vectors[:, 0]
+
+
+def orientation(frames):
+    """(phi, psi) arrays over frames [(nodes, tris), ...]: continuous angles in the x-z plane, from +z towards +x,
+    of the symmetry axis and of the material node nearest the rim on the +x side at the first frame."""
+    phi, psi = [], []
+    previous = None
+    tracked = None
+    for nodes, tris in frames:
+        c, n = symmetry_axis(nodes, tris)
+        if previous is None:
+            if n[2] < 0 or (n[2] == 0 and n[0] < 0):
+                n = -n
+        elif np.dot(n, previous) < 0:
+            n = -n  # the axis is a director: keep the sign continuous between frames
+        previous = n
+        phi.append(np.arctan2(n[0], n[2]))
+        if tracked is None:
+            r = nodes - c
+            tracked = int(np.argmax(r[:, 0] - np.abs(r[:, 1]) - np.abs(r[:, 2])))
+        r = nodes[tracked] - c
+        psi.append(np.arctan2(r[0], r[2]))
+    return np.unwrap(np.array(phi)), np.unwrap(np.array(psi))
+
+
+def summary(kt, phi, psi):
+    """The key figures of one run: flips, phi over the second half, tank-treading frequency f_tt / k."""
+    half = kt >= 0.5 * kt[-1]
+    rel = psi - phi
+    span = kt[half][-1] - kt[half][0]
+    turns = (rel[half][-1] - rel[half][0]) / (2 * np.pi)
+    return {"flips": int(np.floor(abs(phi[-1] - phi[0]) / np.pi + 1e-9)),
+            "phi_mean": float(phi[half].mean()), "phi_min": float(phi[half].min()),
+            "phi_max": float(phi[half].max()),
+            "f_tt": float(turns / span) if span > 0 else 0.0,
+            "rel_range": float(rel[half].max() - rel[half].min())}
+
+
+def read_run(run_dir, membrane):
+    cfg = pc.read_config(run_dir)
+    k = pc.shear_rate(cfg)
+    if k == 0.0:
+        pc.fail(f"{run_dir}: the z walls do not move (k = 0): not a shear run")
+    times, frames = [], []
+    for path in pc.frame_files(run_dir):
+        t, nodes, tris = read_frame(path, membrane)
+        times.append(t)
+        frames.append((nodes, tris))
+    if len(frames) < 3:
+        pc.fail(f"{run_dir}: {len(frames)} frame(s); at least three are needed")
+    phi, psi = orientation(frames)
+    m = cfg["membrane"][membrane]
+    lam = m.get("viscosity_ratio", 1.0)
+    label = f"$\\lambda$ = {lam:g}"
+    if m.get("law") == "skalak" and "R0" in m:
+        label += f", Ca = {cfg['fluid']['mu'] * k * m['R0'] / (m['C11'] / 2):.2g}"
+    label += f" ({pc.resolution_of(cfg, membrane)})"
+    return {"dir": run_dir, "k": k, "lambda": lam, "label": label, "kt": k * np.array(times), "phi": phi,
+            "psi": psi, "frames": frames}
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("run_dirs", nargs="+", metavar="RUN_DIR")
+    parser.add_argument("-o", "--output", help="PNG to write (default rbc_shear.png in the first RUN_DIR)")
+    parser.add_argument("--title", default="A red blood cell in simple shear", help="figure title")
+    parser.add_argument("--membrane", type=int, default=0, help="membrane index (default 0)")
+    args = parser.parse_args()
+
+    runs = [read_run(d, args.membrane) for d in args.run_dirs]
+    fig, (ax_phi, ax_tt) = plt.subplots(1, 2, figsize=(12.0, 4.4))
+    for i, r in enumerate(runs):
+        s = summary(r["kt"], r["phi"], r["psi"])
+        motion = "tumbling" if s["flips"] >= 1 else "swinging/tank-treading"
+        print(f"{r['dir']}: {r['label']}, k t = 0 ... {r['kt'][-1]:.3g}, {len(r['kt'])} frames: {motion}; "
+              f"flips {s['flips']} (phi from {r['phi'][0]:.3f} to {r['phi'][-1]:.3f} rad); second half: "
+              f"phi mean {s['phi_mean']:.3f} rad, range {s['phi_min']:.3f} ... {s['phi_max']:.3f} rad; "
+              f"tank-treading f_tt / k = {s['f_tt']:.4f} (psi - phi spans {s['rel_range']:.3f} rad)")
+        color = f"C{i}"
+        ax_phi.plot(r["kt"], r["phi"] / np.pi, "-", color=color, lw=1.5, label=r["label"])
+        ax_tt.plot(r["kt"], (r["psi"] - r["phi"]) / (2 * np.pi), "-", color=color, lw=1.5, label=r["label"])
+    ax_phi.set_xlabel("dimensionless time k t")
+    ax_phi.set_ylabel("$\\varphi / \\pi$ (symmetry axis from z towards x)")
+    ax_phi.set_title("Orientation of the cell: +1 per flip", fontsize=10)
+    ax_phi.grid(alpha=0.3)
+    ax_phi.legend(fontsize="small", loc="upper left")
+    ax_tt.set_xlabel("dimensionless time k t")
+    ax_tt.set_ylabel("$(\\psi - \\varphi) / 2\\pi$")
+    ax_tt.set_title("Turns of a membrane node around the cell (tank-treading)", fontsize=10)
+    ax_tt.grid(alpha=0.3)
+    ax_tt.legend(fontsize="small", loc="upper left")
+    fig.suptitle(args.title, fontsize=11)
+    fig.tight_layout()
+    out = args.output or os.path.join(args.run_dirs[0], "rbc_shear.png")
+    fig.savefig(out, dpi=pc.DPI)
+    print(f"wrote {out}")
+
+
+if __name__ == "__main__":
+    main()
