@@ -12,9 +12,11 @@ u = (k z, 0, 0) between z walls moving along x), read from the frames fields_NNN
   - psi, the angle in the same plane around the centroid of one material node (the node nearest the rim on the +x
     side at the first frame), made continuous: psi - phi grows by 2 pi per turn of the membrane around the cell when
     it tank-treads, and only oscillates when the cell tumbles (the node stays in place on the cell).
-Prints, per run: the number of flips (whole half-turns of phi), the mean and range of phi over the second half of
-the run, and the tank-treading frequency f_tt / k = (change of psi - phi over the second half) / (2 pi k t).
-Left panel: phi / pi against k t; right panel: (psi - phi) / (2 pi), the membrane's turns around the cell.
+Prints, per run: the number of flips (whole half-turns of phi), the k t at which the axis passes the flow direction,
+the mean and range of phi over the second half of the run, and the tank-treading frequency f_tt / k = (change of psi - phi over the second half) / (2 pi k t).
+Left panel: phi / pi against k t; right panel: (psi - phi) / (2 pi), the membrane's turns around the cell. With
+--shapes KT1,KT2,...: below, one row per run, the cell seen along y (nodes projected on x-z, in micrometres around
+its centroid) at the frames nearest those k t, with its symmetry axis (black) and the tracked node (red).
 Default PNG: rbc_shear.png in the first RUN_DIR.
 """
 import argparse
@@ -65,6 +67,12 @@ def symmetry_axis(nodes, tris):
     return c, vectors[:, 0]
 
 
+def rim_node(nodes, c):
+    """The node farthest out on the +x side, near the plane y = c_y through the centroid c."""
+    r = nodes - c
+    return int(np.argmax(r[:, 0] - np.abs(r[:, 1]) - np.abs(r[:, 2])))
+
+
 def orientation(frames):
     """(phi, psi) arrays over frames [(nodes, tris), ...]: continuous angles in the x-z plane, from +z towards +x,
     of the symmetry axis and of the material node nearest the rim on the +x side at the first frame."""
@@ -81,8 +89,7 @@ def orientation(frames):
         previous = n
         phi.append(np.arctan2(n[0], n[2]))
         if tracked is None:
-            r = nodes - c
-            tracked = int(np.argmax(r[:, 0] - np.abs(r[:, 1]) - np.abs(r[:, 2])))
+            tracked = rim_node(nodes, c)
         r = nodes[tracked] - c
         psi.append(np.arctan2(r[0], r[2]))
     return np.unwrap(np.array(phi)), np.unwrap(np.array(psi))
@@ -94,7 +101,13 @@ def summary(kt, phi, psi):
     rel = psi - phi
     span = kt[half][-1] - kt[half][0]
     turns = (rel[half][-1] - rel[half][0]) / (2 * np.pi)
-    return {"flips": int(np.floor(abs(phi[-1] - phi[0]) / np.pi + 1e-9)),
+    # k t at which the axis passes the flow direction (phi = pi/2 + n pi), between frames by linear interpolation
+    crossings = []
+    level = (phi - np.pi / 2) / np.pi
+    for i in np.nonzero(np.floor(level[1:]) != np.floor(level[:-1]))[0]:
+        target = np.ceil(min(level[i], level[i + 1]))
+        crossings.append(kt[i] + (target - level[i]) / (level[i + 1] - level[i]) * (kt[i + 1] - kt[i]))
+    return {"flips": int(np.floor(abs(phi[-1] - phi[0]) / np.pi + 1e-9)), "crossings": crossings,
             "phi_mean": float(phi[half].mean()), "phi_min": float(phi[half].min()),
             "phi_max": float(phi[half].max()),
             "f_tt": float(turns / span) if span > 0 else 0.0,
@@ -124,23 +137,56 @@ def read_run(run_dir, membrane):
             "psi": psi, "frames": frames}
 
 
+def draw_shape(ax, run, frame, color):
+    """The cell of one frame seen along y (nodes projected on x-z, centred), its symmetry axis and the tracked node."""
+    nodes, tris = run["frames"][frame]
+    c, _ = symmetry_axis(nodes, tris)
+    r = (nodes - c) * 1e6
+    ax.plot(r[:, 0], r[:, 2], ".", color=color, ms=1, alpha=0.3)
+    first, first_tris = run["frames"][0]
+    c0, _ = symmetry_axis(first, first_tris)
+    node = rim_node(first, c0)
+    size = 1.15 * np.abs(first - c0).max() * 1e6
+    phi = run["phi"][frame]
+    ax.plot([-size * np.sin(phi), size * np.sin(phi)], [-size * np.cos(phi), size * np.cos(phi)], "k-", lw=0.8)
+    ax.plot(r[node, 0], r[node, 2], "o", color="red", ms=4)
+    ax.set_aspect("equal")
+    ax.set_xlim(-size, size)
+    ax.set_ylim(-size, size)
+    ax.set_xticks([])
+    ax.set_yticks([])
+    ax.set_title(f"k t = {run['kt'][frame]:.1f}, $\\lambda$ = {run['lambda']:g}", fontsize=8)
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("run_dirs", nargs="+", metavar="RUN_DIR")
     parser.add_argument("-o", "--output", help="PNG to write (default rbc_shear.png in the first RUN_DIR)")
     parser.add_argument("--title", default="A red blood cell in simple shear", help="figure title")
     parser.add_argument("--membrane", type=int, default=0, help="membrane index (default 0)")
+    parser.add_argument("--shapes", metavar="KT1,KT2,...",
+                        help="also draw each run's cell seen along y at the frames nearest these k t (one row per run)")
     args = parser.parse_args()
 
     runs = [read_run(d, args.membrane) for d in args.run_dirs]
-    fig, (ax_phi, ax_tt) = plt.subplots(1, 2, figsize=(12.0, 4.4))
+    times = pc.parse_numbers("--shapes", args.shapes) if args.shapes else []
+    rows = len(runs) if times else 0
+    fig = plt.figure(figsize=(12.0, 4.4 + 1.6 * rows))
+    grid = fig.add_gridspec(1 + rows, 2 * max(len(times), 1), height_ratios=[4.4] + [1.6] * rows)
+    half = max(len(times), 1)
+    ax_phi, ax_tt = fig.add_subplot(grid[0, :half]), fig.add_subplot(grid[0, half:])
     for i, r in enumerate(runs):
         s = summary(r["kt"], r["phi"], r["psi"])
         motion = "tumbling" if s["flips"] >= 1 else "swinging/tank-treading"
-        print(f"{r['dir']}: {r['label']}, k t = 0 ... {r['kt'][-1]:.3g}, {len(r['kt'])} frames: {motion}; "
+        text = r["label"].replace("$\\lambda$", "lambda")
+        print(f"{r['dir']}: {text}, k t = 0 ... {r['kt'][-1]:.3g}, {len(r['kt'])} frames: {motion}; "
               f"flips {s['flips']} (phi from {r['phi'][0]:.3f} to {r['phi'][-1]:.3f} rad); second half: "
               f"phi mean {s['phi_mean']:.3f} rad, range {s['phi_min']:.3f} ... {s['phi_max']:.3f} rad; "
               f"tank-treading f_tt / k = {s['f_tt']:.4f} (psi - phi spans {s['rel_range']:.3f} rad)")
+        if s["crossings"]:
+            c = s["crossings"]
+            gaps = f", k t between flips {np.mean(np.diff(c)):.2f}" if len(c) > 1 else ""
+            print(f"  the axis passes the flow direction at k t = {', '.join(f'{x:.2f}' for x in c)}{gaps}")
         color = f"C{i}"
         ax_phi.plot(r["kt"], r["phi"] / np.pi, "-", color=color, lw=1.5, label=r["label"])
         ax_tt.plot(r["kt"], (r["psi"] - r["phi"]) / (2 * np.pi), "-", color=color, lw=1.5, label=r["label"])
@@ -154,6 +200,10 @@ def main():
     ax_tt.set_title("Turns of a membrane node around the cell (tank-treading)", fontsize=10)
     ax_tt.grid(alpha=0.3)
     ax_tt.legend(fontsize="small", loc="upper left")
+    for i, r in enumerate(runs[:rows]):
+        for j, t in enumerate(times):
+            ax = fig.add_subplot(grid[1 + i, 2 * j:2 * j + 2])
+            draw_shape(ax, r, int(np.argmin(np.abs(r["kt"] - t))), f"C{i}")
     fig.suptitle(args.title, fontsize=11)
     fig.tight_layout()
     out = args.output or os.path.join(args.run_dirs[0], "rbc_shear.png")
