@@ -13,7 +13,8 @@ u = (k z, 0, 0) between z walls moving along x), read from the frames fields_NNN
     side at the first frame), made continuous: psi - phi grows by 2 pi per turn of the membrane around the cell when
     it tank-treads, and only oscillates when the cell tumbles (the node stays in place on the cell).
 Prints, per run: the number of flips (whole half-turns of phi), the k t at which the axis passes the flow direction,
-the mean and range of phi over the second half of the run, and the tank-treading frequency f_tt / k = (change of psi - phi over the second half) / (2 pi k t).
+the mean and range of phi over the second half of the run, and the tank-treading frequency
+f_tt / k = (change of psi - phi over the second half) / (2 pi k t).
 Left panel: phi / pi against k t; right panel: (psi - phi) / (2 pi), the membrane's turns around the cell. With
 --shapes KT1,KT2,...: below, one row per run, the cell seen along y (nodes projected on x-z, in micrometres around
 its centroid) at the frames nearest those k t, with its symmetry axis (black) and the tracked node (red).
@@ -131,7 +132,8 @@ def read_run(run_dir, membrane):
     lam = m.get("viscosity_ratio", 1.0)
     label = f"$\\lambda$ = {lam:g}"
     if m.get("law") == "skalak" and "R0" in m:
-        label += f", Ca = {cfg['fluid']['mu'] * k * m['R0'] / (m['C11'] / 2):.2g}"
+        # G_s = C11 / 2 and C = C21 / (2 G_s) (src/immerse/membrane/Skalak.hpp)
+        label += f", Ca = {cfg['fluid']['mu'] * k * m['R0'] / (m['C11'] / 2):.2g}, C = {m['C21'] / m['C11']:.3g}"
     label += f" ({pc.resolution_of(cfg, membrane)})"
     return {"dir": run_dir, "k": k, "lambda": lam, "label": label, "kt": k * np.array(times), "phi": phi,
             "psi": psi, "frames": frames}
