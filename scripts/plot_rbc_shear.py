@@ -148,10 +148,10 @@ def draw_shape(ax, run, frame, color):
     first, first_tris = run["frames"][0]
     c0, _ = symmetry_axis(first, first_tris)
     node = rim_node(first, c0)
-    size = 1.15 * np.abs(first - c0).max() * 1e6
+    size = 1.1e6 * max(np.linalg.norm(x - x.mean(axis=0), axis=1).max() for x, _ in run["frames"])
     phi = run["phi"][frame]
     ax.plot([-size * np.sin(phi), size * np.sin(phi)], [-size * np.cos(phi), size * np.cos(phi)], "k-", lw=0.8)
-    ax.plot(r[node, 0], r[node, 2], "o", color="red", ms=4)
+    ax.plot(r[node, 0], r[node, 2], "o", color="red", ms=4, zorder=3)
     ax.set_aspect("equal")
     ax.set_xlim(-size, size)
     ax.set_ylim(-size, size)
