@@ -112,6 +112,11 @@ start capsule_pair_quick "$runs/pair"
 start capsule_pair "$runs/pair_full" --set output.fields_every=0
 # Fig. 15: the 32 cells of the channel at t = 0 and t = 0.05 s.
 start rbc_channel "$runs/channel" --set output.fluid_fields=false
+# A red cell in shear at viscosity ratio 1 (tank-treading) and 5 (tumbling), quick and finer size.
+for lambda in 1 5; do
+  start rbc_shear_quick "$runs/rbc_shear_l$lambda" --set "membrane[0].viscosity_ratio=$lambda"
+  start rbc_shear "$runs/rbc_shear_full_l$lambda" --set "membrane[0].viscosity_ratio=$lambda"
+done
 wait
 if compgen -G "$runs/*.failed" >/dev/null; then echo "some runs failed: no figures written"; exit 1; fi
 
@@ -136,3 +141,5 @@ $python scripts/plot_shapes.py "$runs/channel" --frames 0,-1 --box --side x --co
 $python scripts/plot_pair.py "$runs/pair" "$runs/pair_full" -o "$figs/capsule_pair.$ext"
 $python scripts/plot_shapes.py "$runs/pair" --frames 0,5,6,9 --side y --columns 2 \
   --title "Two capsules crossing in shear, G = 0.05, seen along y" -o "$figs/capsule_pair_shapes.$ext"
+$python scripts/plot_rbc_shear.py "$runs"/rbc_shear_l{1,5} "$runs"/rbc_shear_full_l{1,5} --shapes 0,4,8,12,16,20 \
+  -o "$figs/rbc_shear.$ext"
