@@ -2,8 +2,8 @@
 # Installs immerse's build and run dependencies from Debian 12 packages (idempotent).
 set -euo pipefail
 pkgs=(cmake g++ make pkg-config
-      libfftw3-dev libhdf5-dev libtomlplusplus-dev libcli11-dev
-      petsc-dev
+      libfftw3-dev libfftw3-mpi-dev libhdf5-dev libtomlplusplus-dev libcli11-dev
+      petsc-dev openmpi-bin libopenmpi-dev  # MPI: the distributed solver and its tests (mpiexec)
       libgtest-dev libgmock-dev libbenchmark-dev
       python3 python3-matplotlib python3-numpy python3-h5py python3-meshio python3-dev pybind11-dev
       mkdocs mkdocs-material  # scripts/build-docs.sh (the documentation site, test docs.site)

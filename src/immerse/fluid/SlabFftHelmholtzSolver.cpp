@@ -1,0 +1,124 @@
+#include "immerse/fluid/SlabFftHelmholtzSolver.hpp"
+
+#include <fftw3-mpi.h>
+
+#include <cmath>
+#include <cstddef>
+#include <new>
+#include <numbers>
+#include <stdexcept>
+#include <string>
+
+namespace immerse {
+
+SlabFftHelmholtzSolver::SlabFftHelmholtzSolver(const Grid& grid, Layout layout, Communicator comm)
+    : layout_(layout), comm_(comm) {
+  const int comp = static_cast<int>(layout);  // 3: pressure
+  shape_ = layout == Layout::Pressure ? grid.cell_shape() : grid.face_shape(comp);
+  const double h = grid.h();
+  std::array<fftw_r2r_kind, 3> fwd{}, bwd{};
+  for (int a = 0; a < 3; ++a) {
+    const int n = grid.n(a);
+    double shift = 0;  // eigen frequency of slot s is s + shift; the period is `period` slots
+    double period = n;
+    if (grid.periodic(a)) {
+      m_[a] = n;
+      fwd[a] = FFTW_R2HC;
+      bwd[a] = FFTW_HC2R;
+      normalization_ *= n;
+    } else {
+      period = 2.0 * n;
+      normalization_ *= 2.0 * n;
+      if (comp == a) {  // face-normal: the N−1 interior faces, DST-I
+        m_[a] = n - 1;
+        lo_[a] = 1;
+        fwd[a] = bwd[a] = FFTW_RODFT00;
+        shift = 1;
+      } else if (comp < 3) {  // cell-centred velocity with ghost 2u_w − u_0: DST-II / DST-III
+        m_[a] = n;
+        fwd[a] = FFTW_RODFT10;
+        bwd[a] = FFTW_RODFT01;
+        shift = 1;
+      } else {  // pressure, homogeneous Neumann: DCT-II / DCT-III
+        m_[a] = n;
+        fwd[a] = FFTW_REDFT10;
+        bwd[a] = FFTW_REDFT01;
+      }
+    }
+    lambda_[a].resize(m_[a]);
+    for (int s = 0; s < m_[a]; ++s) {
+      const double sn = std::sin(std::numbers::pi * (s + shift) / period);
+      lambda_[a][s] = -4.0 / (h * h) * sn * sn;
+    }
+  }
+  const int processes = comm_.size();
+  if (processes > m_[2])
+    throw std::invalid_argument("SlabFftHelmholtzSolver: " + std::to_string(processes) + " processes for " +
+                                std::to_string(m_[2]) +
+                                " planes of unknowns along z (the slab axis): use at most one process per plane");
+  // FFTW-MPI needs its own initialization (idempotent) and, for reproducible plans, one thread per process.
+  fftw_init_threads();
+  fftw_mpi_init();
+  fftw_plan_with_nthreads(1);
+  // Array3 is x fastest: in FFTW's row-major terms the dimensions are {z, y, x}, z distributed.
+  ptrdiff_t local_n0 = 0, local_0_start = 0;
+  const ptrdiff_t alloc = fftw_mpi_local_size_3d(m_[2], m_[1], m_[0], comm_.comm(), &local_n0, &local_0_start);
+  local_planes_ = static_cast<int>(local_n0);
+  first_plane_ = static_cast<int>(local_0_start);
+  buf_ = fftw_alloc_real(static_cast<std::size_t>(alloc > 0 ? alloc : 1));
+  if (buf_ == nullptr) throw std::bad_alloc();
+  forward_ = fftw_mpi_plan_r2r_3d(m_[2], m_[1], m_[0], buf_, buf_, comm_.comm(), fwd[2], fwd[1], fwd[0], FFTW_ESTIMATE);
+  backward_ = fftw_mpi_plan_r2r_3d(m_[2], m_[1], m_[0], buf_, buf_, comm_.comm(), bwd[2], bwd[1], bwd[0], FFTW_ESTIMATE);
+  if (forward_ == nullptr || backward_ == nullptr) {
+    if (forward_) fftw_destroy_plan(forward_);
+    if (backward_) fftw_destroy_plan(backward_);
+    fftw_free(buf_);
+    throw std::runtime_error("FFTW-MPI could not plan a distributed fast solver");
+  }
+}
+
+SlabFftHelmholtzSolver::~SlabFftHelmholtzSolver() {
+  fftw_destroy_plan(forward_);
+  fftw_destroy_plan(backward_);
+  fftw_free(buf_);
+}
+
+void SlabFftHelmholtzSolver::set_symbol(double alpha, double beta) {
+  const int mx = m_[0], my = m_[1], nz = local_planes_;
+  const double* lx = lambda_[0].data();
+  const double* ly = lambda_[1].data();
+  const double* lz = lambda_[2].data() + first_plane_;  // the global index of each local plane
+  inverse_.resize(static_cast<std::size_t>(mx) * my * nz);
+  for (int k = 0; k < nz; ++k)
+    for (int j = 0; j < my; ++j) {
+      double* const row = inverse_.data() + mx * (j + my * static_cast<std::size_t>(k));
+      for (int i = 0; i < mx; ++i) {
+        const double den = (alpha + beta * (lx[i] + ly[j] + lz[k])) * normalization_;
+        row[i] = den == 0.0 ? 0.0 : 1.0 / den;
+      }
+    }
+  alpha_ = alpha;
+  beta_ = beta;
+}
+
+void SlabFftHelmholtzSolver::solve(Array3& x, double alpha, double beta) {
+  const int mx = m_[0], my = m_[1], nz = local_planes_;
+  const int ox = lo_[0], oy = lo_[1];
+  if (x.nx() != shape_[0] || x.ny() != shape_[1] || x.nz() != nz)
+    throw std::logic_error("SlabFftHelmholtzSolver::solve: the array is not this process's slab (local_shape())");
+  double* const b = buf_;
+  for (int k = 0; k < nz; ++k)
+    for (int j = 0; j < my; ++j)
+      for (int i = 0; i < mx; ++i) b[i + mx * (j + my * static_cast<std::size_t>(k))] = x(i + ox, j + oy, k);
+  if (!(alpha == alpha_ && beta == beta_)) set_symbol(alpha, beta);
+  fftw_execute(forward_);
+  const double* const inv = inverse_.data();
+  const std::size_t total = inverse_.size();
+  for (std::size_t n = 0; n < total; ++n) b[n] *= inv[n];
+  fftw_execute(backward_);
+  for (int k = 0; k < nz; ++k)
+    for (int j = 0; j < my; ++j)
+      for (int i = 0; i < mx; ++i) x(i + ox, j + oy, k) = b[i + mx * (j + my * static_cast<std::size_t>(k))];
+}
+
+}  // namespace immerse
