@@ -29,9 +29,11 @@ def main():
         step = diag["step"]
         newton = diag["newton_its"]
         gmres_per_newton = np.divide(diag["gmres_its"], newton, out=np.zeros_like(newton), where=newton > 0)
-        ax.plot(step, newton, "o-", ms=2 if len(step) > 200 else 3, lw=1, label="Newton iterations")
-        ax.plot(step, gmres_per_newton, "s--", ms=2 if len(step) > 200 else 3, lw=1,
-                label="GMRES iterations per Newton iteration")
+        # Long runs as markers only: lines between steps of 0 and 1 iterations would fill the panel.
+        many = len(step) > 200
+        ax.plot(step, newton, "o" if many else "o-", ms=2.5 if many else 3, lw=1, label="Newton iterations")
+        ax.plot(step, gmres_per_newton + (0.08 if many else 0.0), "s" if many else "s--", ms=2.5 if many else 3,
+                lw=1, mfc="none", label="GMRES iterations per Newton iteration" + (" (+0.08)" if many else ""))
         ax.set_xlabel("time step")
         ax.set_ylabel("iterations per step")
         ax.set_ylim(bottom=0)

@@ -59,8 +59,9 @@ def main():
     if len(runs) > len(STYLES):
         pc.fail(f"{len(runs)} runs given: at most {len(STYLES)} (one line style each)")
 
-    paper = all(round(mu0 * 1e6, 6) in PAPER_STYLES for mu0, _, _ in runs)
-    fig, ax = plt.subplots(figsize=(6.4, 4.8))
+    moduli = [round(mu0 * 1e6, 6) for mu0, _, _ in runs]
+    paper = all(m in PAPER_STYLES for m in moduli) and len(set(moduli)) == len(moduli)
+    fig, ax = plt.subplots(figsize=(7.2, 6.0))
     for i, (mu0, run_dir, cfg) in enumerate(runs):
         force, axial, transverse = pc.read_stretch(run_dir)
         style = PAPER_STYLES[round(mu0 * 1e6, 6)] if paper else STYLES[i]
@@ -86,7 +87,7 @@ def main():
     ax.set_ylim(bottom=0)
     ax.set_title("Red blood cell stretched by optical tweezers")
     ax.grid(alpha=0.3)
-    ax.legend(loc="center right", fontsize="small")
+    ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.13), fontsize="small", ncol=2)
     fig.tight_layout()
     out = args.output or os.path.join(args.run_dirs[0], "stretch.png")
     fig.savefig(out, dpi=pc.DPI)
