@@ -1,5 +1,6 @@
-// Variable viscosity (docs/viscosity-contrast.md): the stress kernel against the Laplacian, a manufactured flow with a
-// smooth viscosity at second order in space and time, and the interior indicator of a sphere.
+// Variable viscosity (docs/viscosity-contrast.md): the stress kernel against the Laplacian, manufactured flows with a
+// smooth viscosity at second order in space and time (periodic, and with the viscosity varying at no-slip walls), and
+// the interior indicator of a sphere.
 #include <gtest/gtest.h>
 #include <omp.h>
 
