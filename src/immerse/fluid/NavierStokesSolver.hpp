@@ -48,6 +48,7 @@
 // Verified by: the studies fluid_divergence, taylor_green, abc_flow, couette, duct_poiseuille, closed_box_mms and the
 // tests NavierStokesSolver.*, CompareRuns.TimeStepErrorInTheStokesRegimeIsSecondOrderWithTheExtrapolatedPressure,
 // ViscosityContrast.ManufacturedFlowIsSecondOrderInSpaceAndTime, ViscosityContrast.ManufacturedFlowInAClosedBox*,
+// ViscosityContrast.ManufacturedFlowWithTheViscosityVaryingAtTheWalls*,
 // ViscosityContrast.UnforcedFlowDecaysInTheStokesLimitWhenTheImplicitViscosityIsTheLargest.
 #include <array>
 #include <cstdint>
