@@ -500,12 +500,12 @@ TEST(ViscosityContrast, UnforcedFlowDecaysInTheStokesLimitWhenTheImplicitViscosi
 }
 
 TEST(ViscosityContrast, IndicatorOfASphereIsTheContrastInsideAndZeroOutside) {
-  // In the middle of the box, and 1.5 cells from the wall z = 0 (the delta function reaches the wall faces).
+  // In the middle of the box, and 1.2 cells from the wall z = 0 (the delta function reaches the wall faces).
   const Grid grid({24, 24, 24}, {3.0, 3.0, 3.0}, {P, P, W});
   IBCoupler coupler(grid);
   ViscosityIndicator indicator(coupler);
   const Mesh mesh = icosahedral_sphere(3);
-  for (const Vec3& c : {Vec3{1.5, 1.45, 1.55}, Vec3{1.5, 1.45, 0.8 + 1.5 * grid.h()}}) {
+  for (const Vec3& c : {Vec3{1.5, 1.45, 1.55}, Vec3{1.5, 1.45, 0.8 + 1.2 * grid.h()}}) {
     std::vector<Vec3> X;
     for (const Vec3& p : mesh.nodes) X.push_back(c + 0.8 * p);
     const double V = volume(mesh, X);
