@@ -220,9 +220,8 @@ INSTANTIATE_TEST_SUITE_P(
                  "wall x = 1"},
         BadInput{"viscosity_ratio_out_of_range", "", {"membrane[0].viscosity_ratio=20"}, "",
                  "membrane[0].viscosity_ratio = 20: must be a finite number in [0.1, 10]"},
-        BadInput{"viscosity_contrast_near_a_wall", "", {"membrane[0].viscosity_ratio=2", "membrane[0].center=[0.4,0.5,0.5]"},
-                 "", "membrane[0].viscosity_ratio = 2: the membrane comes within 0.15 m of a wall and must keep at least "
-                 "five cells (0.3125 m) clear with a viscosity contrast"},
+        BadInput{"viscosity_contrast_at_a_wall", "", {"membrane[0].viscosity_ratio=2", "membrane[0].center=[0.28,0.5,0.5]"},
+                 "", "membrane[0] comes within 0.03 m of a wall: must keep at least one cell (0.0625 m) clear"},
         BadInput{"membrane_at_wall", "", {"membrane[0].center=[0.28,0.5,0.5]"}, "",
                  "membrane[0] comes within 0.03 m of a wall: must keep at least one cell (0.0625 m) clear"},
         BadInput{"overlapping_membranes", "two_membranes.toml", {"membrane[1].mesh.level=1"}, "",

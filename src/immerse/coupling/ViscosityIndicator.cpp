@@ -1,6 +1,7 @@
 #include "immerse/coupling/ViscosityIndicator.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 
 #include "immerse/fluid/MacStencilGrid.hpp"
@@ -38,8 +39,20 @@ void ViscosityIndicator::compute(std::span<const IndicatorSurface> surfaces, Arr
     return;
   }
   coupler_.spread_force(X_, N_, normals_);
-  // ∇_h² χ = −D_h G (wall faces carry no G: the membranes stay away from the walls).
+  // ∇_h² χ = −D_h G with ∂χ/∂n = 0 at the walls: the wall faces carry no G (what the kernel spreads there is dropped),
+  // so the Neumann problem is compatible, Σ D_h G = 0.
   const MacStencilGrid g(grid);
+  for (int d = 0; d < 3; ++d) {
+    if (g.periodic[d]) continue;
+    Array3& G = normals_[d];
+    const int e1 = (d + 1) % 3, e2 = (d + 2) % 3;
+    for (const int wall : {0, g.n[d]}) {
+      std::array<int, 3> q{};
+      q[d] = wall;
+      for (q[e2] = 0; q[e2] < G.n(e2); ++q[e2])
+        for (q[e1] = 0; q[e1] < G.n(e1); ++q[e1]) G(q[0], q[1], q[2]) = 0.0;
+    }
+  }
   for_each_cell(g, [&](int i, int j, int k) { work_(i, j, k) = -mac::divergence_cell(normals_, g, {i, j, k}); });
   solver_->solve(work_, 0.0, 1.0);
   // The free constant: Σ χ h³ = Σ_m (λ_m − 1) V_m (a serial sum: the same in every thread count).

@@ -7,10 +7,11 @@
 //   ∇_h² χ = −D_h G,   G = Σ_m (λ_m − 1) Σ_l N_l δ_h(x − X_l),   N_l = ∫ φ_l n dA = ∂V_m/∂X_l
 //
 // with D_h the MAC divergence, G spread to the faces by the force-spreading kernel (IBCoupler, eq. 6) and the
-// Poisson problem solved by the pressure layout's fast solver (periodic, or Neumann at walls). Its free constant is
-// fixed so that Σ χ h³ = Σ_m (λ_m − 1) V_m (V_m from the mesh, exact for the curved elements); then χ is clipped to
-// [min(0, λ_m − 1), max(0, λ_m − 1)] over the membranes, and values below kFloor · max_m |λ_m − 1| in magnitude (the
-// discretization error of the far field) are set to zero, so that χ vanishes exactly away from the membranes.
+// Poisson problem solved by the pressure layout's fast solver (periodic, or Neumann at walls, where the G spread onto
+// the wall faces is dropped). Its free constant is fixed so that Σ χ h³ = Σ_m (λ_m − 1) V_m (V_m from the mesh,
+// exact for the curved elements); then χ is clipped to [min(0, λ_m − 1), max(0, λ_m − 1)] over the membranes, and
+// values below kFloor · max_m |λ_m − 1| in magnitude (the discretization error of the far field) are set to zero, so
+// that χ vanishes exactly away from the membranes.
 // Bitwise independent of the thread count (the spreading is; the sums are serial).
 // Verified by: the test ViscosityContrast.IndicatorOfASphereIsTheContrastInsideAndZeroOutside (a sphere, λ = 5 and
 // 0.2: χ inside, outside and its integral) and the capsule of ViscosityContrastShear.*.

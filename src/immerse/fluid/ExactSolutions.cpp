@@ -111,6 +111,12 @@ Vec3 ClosedBoxMms::velocity(const Vec3& x, double t) const {
   return Vec3{spatial(0, x, none), spatial(1, x, none), spatial(2, x, none)} * std::cos(t);
 }
 
+double ClosedBoxMms::gradient(const Vec3& x, int i, int j) const {
+  int first[3] = {0, 0, 0};
+  first[j] = 1;
+  return spatial(i, x, first);
+}
+
 double ClosedBoxMms::pressure(const Vec3& x, double t) const {
   return std::cos(t) * std::sin(pi * x.x) * std::sin(pi * x.y) * std::sin(pi * x.z);
 }

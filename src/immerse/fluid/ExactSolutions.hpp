@@ -52,6 +52,8 @@ struct ClosedBoxMms {
   Vec3 velocity(const Vec3& x, double t) const;
   double pressure(const Vec3& x, double t) const;
   Vec3 force(const Vec3& x, double t) const;
+  /// ∂_j S_i of the spatial factor S = u / T(t).
+  double gradient(const Vec3& x, int i, int j) const;
   /// The force separates in time: with u = T(t) S(x), p = T(t) Π(x),
   /// F = ρ T' S + ρ T² (S·∇)S + T ∇Π − μ T ΔS = Σ_i c_i(t) part_i(x); so a grid can sample the parts once.
   std::array<Vec3, 4> force_parts(const Vec3& x) const;

@@ -454,16 +454,12 @@ IndexBox NavierStokesSolver::variable_stress_box(const Array3& chi) const {
   if (hi[0] < 0) return IndexBox{{0, 0, 0}, {0, 0, 0}};
   IndexBox box{};
   for (int a = 0; a < 3; ++a) {
-    if (!g.periodic[a] && (lo[a] < 3 || hi[a] > g.n[a] - 4))
-      throw SimulationError(
-          "viscosity contrast: the interior of a membrane with viscosity_ratio != 1 reaches within three cells of a "
-          "wall (its indicator must vanish there)");
     if (g.periodic[a] && (lo[a] < 1 || hi[a] > g.n[a] - 2)) {
       box.begin[a] = 0;
       box.end[a] = g.n[a];
     } else {
-      box.begin[a] = lo[a] - 1;
-      box.end[a] = hi[a] + 2;
+      box.begin[a] = std::max(lo[a] - 1, 0);
+      box.end[a] = std::min(hi[a] + 2, g.n[a]);
     }
   }
   return box;

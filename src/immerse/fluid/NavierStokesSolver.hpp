@@ -39,7 +39,7 @@
 // (ũ = u^n on the first step), the remainder at the extrapolated midpoint velocity: a Douglas–Dupont-type
 // stabilization, as in Fai, Griffith, Mori & Peskin (2013, SIAM J. Sci. Comput. 35). With D_h ũ = 0,
 // L_μ ũ = μ ∇_h² ũ + μ ∇_h·(χ(∇_h ũ + ∇_h ũᵀ)) (ViscousStress_K.hpp): the first part carries the wall values, the
-// second vanishes where χ does, which must hold within three cells of every wall (SimulationError otherwise).
+// second vanishes where χ does and takes the wall values of the first where χ reaches a wall.
 // prepare() adds (μ_p − μ) ∇_h²(u^n/2 − ũ) (homogeneous walls) to E; step(prepared, F, out, χ) adds μ ∇_h·(χ S(ũ)).
 // (I − (μ_p Δt/2ρ) ∇_h²) is what is inverted, so (13) takes μ_p: p^{n+1/2} = p̃ + φ − (μ_p/2) D u* makes the step's
 // u^{n+1} satisfy (9) with G p^{n+1/2} exactly, as (13) does for a constant μ. Without variable viscosity
@@ -48,6 +48,7 @@
 // Verified by: the studies fluid_divergence, taylor_green, abc_flow, couette, duct_poiseuille, closed_box_mms and the
 // tests NavierStokesSolver.*, CompareRuns.TimeStepErrorInTheStokesRegimeIsSecondOrderWithTheExtrapolatedPressure,
 // ViscosityContrast.ManufacturedFlowIsSecondOrderInSpaceAndTime, ViscosityContrast.ManufacturedFlowInAClosedBox*,
+// ViscosityContrast.ManufacturedFlowWithTheViscosityVaryingAtTheWalls*,
 // ViscosityContrast.UnforcedFlowDecaysInTheStokesLimitWhenTheImplicitViscosityIsTheLargest.
 #include <array>
 #include <cstdint>
@@ -145,12 +146,10 @@ class NavierStokesSolver {
   template <class Rhs>
   void advance(const FluidState& in, double dt, const Array3& p, FluidState& out, Rhs&& rhs);
 
-  /// Adds (Δt/ρ) μ ∇_h·(χ S(ũ)) to the right-hand side u* of (9) where χ is not zero (SimulationError when χ is not
-  /// zero within three cells of a wall).
+  /// Adds (Δt/ρ) μ ∇_h·(χ S(ũ)) to the right-hand side u* of (9) where χ is not zero.
   /// Component d of it, over the box of faces where it may not vanish (variable_stress_box).
   void add_variable_stress(const FaceField& utilde, const Array3& chi, double dt, int d, const IndexBox& box);
-  /// The faces whose stress term reads a non-zero χ (an empty box when χ = 0 everywhere); SimulationError when χ is
-  /// not zero within three cells of a wall.
+  /// The faces whose stress term reads a non-zero χ (an empty box when χ = 0 everywhere).
   IndexBox variable_stress_box(const Array3& chi) const;
   /// ũ and (μ_p − μ) ∇_h²(u^n/2 − ũ) added to the explicit terms of `prepared`.
   void prepare_variable(const FluidState& in, double dt, PreparedStep& prepared) const;

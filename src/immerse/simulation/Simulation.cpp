@@ -341,13 +341,6 @@ void Simulation::check_geometry() const {
         << " m) clear for the delta function" << unit_hint(config_, m);
       throw InputError(s.str());
     }
-    // The interior indicator reaches about two cells beyond the surface and must vanish within three of a wall.
-    if (viscosity_ratio_[m] != 1.0 && d < 5 * h) {
-      std::ostringstream s;
-      s << membrane_name(m) << ".viscosity_ratio = " << viscosity_ratio_[m] << ": the membrane comes within " << d
-        << " m of a wall and must keep at least five cells (" << 5 * h << " m) clear with a viscosity contrast";
-      throw InputError(s.str());
-    }
   }
   if (const auto gap = closest_foreign_nodes(grid_, initial_, h)) {
     std::ostringstream s;
