@@ -18,7 +18,7 @@
 // executed whenever OpenMP's thread count is above one when solve() is called (ThreadGovernor may change it). The plans work
 // on an internal buffer (the unknowns copied in and out), or, for a solver made for one array whose unknowns are
 // the whole array (every layout but a face-normal component on a wall axis), on that array itself. Not reentrant.
-// A distributed (FFTW-MPI) backend can replace this class behind the same solve().
+// SlabFftHelmholtzSolver distributes the same transforms (FftAxis) over MPI processes.
 // Verified by: the study fluid_solvers (residual of every Helmholtz/Poisson solve, every layout and boundary
 // combination, ≤ 1e-11) and the tests FftHelmholtzSolver.* (the tabulated eigenvectors, a manufactured Helmholtz solution).
 #include <array>

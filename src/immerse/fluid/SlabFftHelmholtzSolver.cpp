@@ -5,51 +5,26 @@
 #include <cmath>
 #include <cstddef>
 #include <new>
-#include <numbers>
 #include <stdexcept>
 #include <string>
+#include <utility>
+
+#include "immerse/fluid/FftAxis.hpp"
 
 namespace immerse {
 
 SlabFftHelmholtzSolver::SlabFftHelmholtzSolver(const Grid& grid, Layout layout, Communicator comm)
     : layout_(layout), comm_(comm) {
-  const int comp = static_cast<int>(layout);  // 3: pressure
-  shape_ = layout == Layout::Pressure ? grid.cell_shape() : grid.face_shape(comp);
-  const double h = grid.h();
+  shape_ = layout == Layout::Pressure ? grid.cell_shape() : grid.face_shape(static_cast<int>(layout));
   std::array<fftw_r2r_kind, 3> fwd{}, bwd{};
   for (int a = 0; a < 3; ++a) {
-    const int n = grid.n(a);
-    double shift = 0;  // eigen frequency of slot s is s + shift; the period is `period` slots
-    double period = n;
-    if (grid.periodic(a)) {
-      m_[a] = n;
-      fwd[a] = FFTW_R2HC;
-      bwd[a] = FFTW_HC2R;
-      normalization_ *= n;
-    } else {
-      period = 2.0 * n;
-      normalization_ *= 2.0 * n;
-      if (comp == a) {  // face-normal: the N−1 interior faces, DST-I
-        m_[a] = n - 1;
-        lo_[a] = 1;
-        fwd[a] = bwd[a] = FFTW_RODFT00;
-        shift = 1;
-      } else if (comp < 3) {  // cell-centred velocity with ghost 2u_w − u_0: DST-II / DST-III
-        m_[a] = n;
-        fwd[a] = FFTW_RODFT10;
-        bwd[a] = FFTW_RODFT01;
-        shift = 1;
-      } else {  // pressure, homogeneous Neumann: DCT-II / DCT-III
-        m_[a] = n;
-        fwd[a] = FFTW_REDFT10;
-        bwd[a] = FFTW_REDFT01;
-      }
-    }
-    lambda_[a].resize(m_[a]);
-    for (int s = 0; s < m_[a]; ++s) {
-      const double sn = std::sin(std::numbers::pi * (s + shift) / period);
-      lambda_[a][s] = -4.0 / (h * h) * sn * sn;
-    }
+    FftAxis axis = fft_axis(grid, layout, a);
+    m_[a] = axis.count;
+    lo_[a] = axis.first;
+    fwd[a] = axis.forward;
+    bwd[a] = axis.backward;
+    normalization_ *= axis.normalization;
+    lambda_[a] = std::move(axis.lambda);
   }
   const int processes = comm_.size();
   if (processes > m_[2])
@@ -89,14 +64,7 @@ void SlabFftHelmholtzSolver::set_symbol(double alpha, double beta) {
   const double* ly = lambda_[1].data();
   const double* lz = lambda_[2].data() + first_plane_;  // the global index of each local plane
   inverse_.resize(static_cast<std::size_t>(mx) * my * nz);
-  for (int k = 0; k < nz; ++k)
-    for (int j = 0; j < my; ++j) {
-      double* const row = inverse_.data() + mx * (j + my * static_cast<std::size_t>(k));
-      for (int i = 0; i < mx; ++i) {
-        const double den = (alpha + beta * (lx[i] + ly[j] + lz[k])) * normalization_;
-        row[i] = den == 0.0 ? 0.0 : 1.0 / den;
-      }
-    }
+  tabulate_inverse_symbol(lx, ly, lz, mx, my, nz, alpha, beta, normalization_, inverse_.data(), false);
   alpha_ = alpha;
   beta_ = beta;
 }
