@@ -564,3 +564,28 @@ TEST(NavierStokesSolver, VariableStepAdamsBashforthStaysSecondOrder) {
     EXPECT_GE(verify::min_observed_order(errors), 1.9);
   }
 }
+
+// Plane Couette flow u_x = U_lower + k (z − z_lower): the discrete wall stress is μ k on both walls, exactly; a
+// uniform χ in the wall cells scales it by 1 + χ; a parabolic profile u_x = a z (Lz − z) gives ±μ a (Lz − h/2), the
+// viscous flux the scheme applies at the wall (first order in h as a derivative; in a discrete steady state it is the
+// flux that balances the momentum exactly).
+TEST(FluidDiagnostics, WallShearStressOfCouetteAndParabolicFlows) {
+  const Grid grid({8, 6, 10}, {0.8, 0.6, 1.0}, {P, P, W}, {0.0, 0.0, -0.3});
+  const double mu = 0.7, k = 1.9, lower = -0.4, upper = lower + k * 1.0;
+  FaceField u(grid);
+  sample_velocity(grid, [&](const Vec3& x) { return Vec3{lower + k * (x.z + 0.3), 0.0, 0.0}; }, u);
+  EXPECT_NEAR(wall_shear_stress(grid, u, nullptr, mu, false, lower), mu * k, 1e-13);
+  EXPECT_NEAR(wall_shear_stress(grid, u, nullptr, mu, true, upper), mu * k, 1e-13);
+  Array3 chi(8, 6, 10, 0.0);
+  for (int j = 0; j < 6; ++j)
+    for (int i = 0; i < 8; ++i) chi(i, j, 0) = 4.0;
+  EXPECT_NEAR(wall_shear_stress(grid, u, &chi, mu, false, lower), 5.0 * mu * k, 1e-12);
+  EXPECT_NEAR(wall_shear_stress(grid, u, &chi, mu, true, upper), mu * k, 1e-13);
+  const double a = 3.0;
+  sample_velocity(grid, [&](const Vec3& x) { return Vec3{a * (x.z + 0.3) * (0.7 - x.z), 0.0, 0.0}; }, u);
+  const double h = grid.h();
+  EXPECT_NEAR(wall_shear_stress(grid, u, nullptr, mu, false, 0.0), mu * a * (1.0 - h / 2), 1e-12);
+  EXPECT_NEAR(wall_shear_stress(grid, u, nullptr, mu, true, 0.0), -mu * a * (1.0 - h / 2), 1e-12);
+  EXPECT_THROW(wall_shear_stress(Grid({8, 6, 10}, {0.8, 0.6, 1.0}, {P, P, P}), u, nullptr, mu, false, 0.0),
+               std::invalid_argument);
+}

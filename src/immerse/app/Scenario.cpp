@@ -249,8 +249,23 @@ io::Config derive_contact(io::Config config) {
   return config;
 }
 
+// suspension_shear: a plane Couette flow along x between walls z = const, whatever fills it.
+io::Config check_suspension_shear(const io::Config& config) {
+  const std::string kind = "\"wall\" for scenario.kind = \"suspension_shear\" (plane Couette flow along x)";
+  require(config.get<std::string>("boundary.z") == "wall", "boundary.z", kind);
+  require(config.get<std::string>("boundary.x") == "periodic", "boundary.x",
+          "\"periodic\" for scenario.kind = \"suspension_shear\" (the flow direction)");
+  if (shear_rate(config) == 0)
+    throw InputError("boundary.z_upper_velocity = " + config.value_text("boundary.z_upper_velocity") +
+                     ": scenario.kind = \"suspension_shear\" needs the walls z = const moving along x only, at "
+                     "different velocities (boundary.z_lower_velocity = " +
+                     config.value_text("boundary.z_lower_velocity") + ")");
+  return config;
+}
+
 io::Config derive(const io::Config& config) {
   const std::string kind = config.get<std::string>("scenario.kind");
+  if (kind == "suspension_shear") return derive_contact(derive_centres(check_suspension_shear(config)));
   if (kind == "rbc_stretch" || kind == "rbc_channel") return derive_contact(derive_centres(derive_cells(config, kind)));
   if (is_shear(kind)) return derive_contact(derive_centres(derive_shear(config, kind)));
   return derive_contact(derive_centres(config));

@@ -2,6 +2,7 @@
 
 #include "immerse/app/ChannelRun.hpp"
 #include "immerse/app/StretchSweepRun.hpp"
+#include "immerse/app/SuspensionShearRun.hpp"
 
 namespace immerse {
 
@@ -9,6 +10,7 @@ std::unique_ptr<ScenarioRun> make_scenario_run(const io::Config& config) {
   const std::string kind = config.get<std::string>("scenario.kind");
   if (kind == "rbc_stretch") return std::make_unique<StretchSweepRun>();
   if (kind == "rbc_channel") return std::make_unique<ChannelRun>();
+  if (kind == "suspension_shear") return std::make_unique<SuspensionShearRun>(config);
   return std::make_unique<ScenarioRun>();
 }
 

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <stdexcept>
 
 #include "immerse/fluid/MacStencil_K.hpp"
 
@@ -48,6 +49,22 @@ double max_abs_velocity(const Grid& grid, const FaceField& u) {
   for (int d = 0; d < 3; ++d)
     serial_faces(g, d, [&](int i, int j, int k) { m = std::max(m, std::abs(u[d](i, j, k))); });
   return m;
+}
+
+double wall_shear_stress(const Grid& grid, const FaceField& u, const Array3* chi, double mu, bool upper,
+                         double wall_velocity_x) {
+  if (grid.periodic(2) || !grid.periodic(0))
+    throw std::invalid_argument("wall_shear_stress: needs walls along z and a periodic x axis");
+  const int nx = grid.n(0), ny = grid.n(1), k = upper ? grid.n(2) - 1 : 0;
+  const bool contrast = chi != nullptr && chi->size() > 0;
+  double sum = 0;
+  for (int j = 0; j < ny; ++j)
+    for (int i = 0; i < nx; ++i) {
+      const double dudz = 2.0 * (upper ? wall_velocity_x - u[0](i, j, k) : u[0](i, j, k) - wall_velocity_x) / grid.h();
+      const double c = contrast ? 0.5 * ((*chi)(i, j, k) + (*chi)((i + nx - 1) % nx, j, k)) : 0.0;
+      sum += (1.0 + c) * dudz;
+    }
+  return mu * sum / (double(nx) * double(ny));
 }
 
 void apply_operator(const Grid& grid, Layout layout, const Array3& x, double alpha, double beta, Array3& out) {

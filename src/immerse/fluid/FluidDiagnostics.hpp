@@ -14,6 +14,16 @@ namespace immerse {
 /// D^MAC u at every cell (wall faces of u are read as stored).
 void divergence(const Grid& grid, const FaceField& u, Array3& div);
 
+/// Mean over the wall z = z_lower (upper = false) or z = z_upper of the shear stress μ (1 + χ) ∂u_x/∂z that the
+/// viscous term of (9) applies there: ∂u_x/∂z = 2 (u_x(first cell) − U_x) / h at the lower wall and
+/// 2 (U_x − u_x(last cell)) / h at the upper one (the ghost 2 U − u of MacStencil_K.hpp; ∂u_z/∂x = 0 on the wall),
+/// χ at the wall edge the mean of its two cells (ViscousStress_K.hpp), χ = 0 where chi is null or empty. In plane
+/// Couette flow u_x = U_lower + k (z − z_lower) both walls give μ k; the flux is first order in h as a derivative of a
+/// curved profile, and in a discrete steady state it is the one that balances the momentum exactly. Needs z walls
+/// and a periodic x axis (std::invalid_argument otherwise).
+double wall_shear_stress(const Grid& grid, const FaceField& u, const Array3* chi, double mu, bool upper,
+                         double wall_velocity_x);
+
 /// Largest |value| of velocity over the unknown faces (all components).
 double max_abs_velocity(const Grid& grid, const FaceField& u);
 

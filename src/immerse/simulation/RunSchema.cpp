@@ -75,7 +75,7 @@ ConfigSchema run_schema() {
   ConfigSchema s;
   s.add_string("scenario.kind", "custom",
                {"custom", "none", "oscillating_membrane", "capsule_shear", "oblate_shear", "bending_shear",
-                "rbc_stretch", "rbc_channel"},
+                "rbc_stretch", "rbc_channel", "suspension_shear"},
                "custom: your own experiment, every value as given (\"none\" is its former name); otherwise an experiment "
                "of the paper whose nondimensional groups below set the dimensional values the file leaves unset "
                "(see scenarios/README.md)");
