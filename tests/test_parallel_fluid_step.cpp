@@ -131,7 +131,8 @@ double relative_difference(const FaceField& a, const FaceField& b) {
 
 bool bitwise_equal(const FluidState& a, const FluidState& b) {
   bool same = a.p.values() == b.p.values() && a.p_prev.values() == b.p_prev.values();
-  for (int d = 0; d < 3; ++d) same = same && a.u[d].values() == b.u[d].values() && a.adv[d].values() == b.adv[d].values();
+  for (int d = 0; d < 3; ++d)
+    same = same && a.u[d].values() == b.u[d].values() && a.adv[d].values() == b.adv[d].values();
   return same;
 }
 

@@ -25,7 +25,8 @@
 //
 // The result equals the serial step's to round-off (the distributed transforms need not be planned like the serial
 // ones; on the test grids they give the same bits) and is bitwise the same on every run with the same number of
-// processes (FFTW_ESTIMATE plans, one thread per process, fixed message order). Construction, scatter/gather and step() are collective over the communicator. No global state.
+// processes (FFTW_ESTIMATE plans, one thread per process, fixed message order). Construction, scatter/gather and
+// step() are collective over the communicator. No global state.
 // Verified by: the tests ParallelFluidStep.* (tests/test_parallel_fluid_step.cpp, run with 1, 2 and 3 processes: five
 // steps in a periodic box, between moving z walls and in a channel equal the serial steps within 1e-12, repeat
 // bitwise, and leave D u^{n+1} ≤ 1e-12).

@@ -9,7 +9,8 @@
 // for u_z the wall face itself, the normal wall velocity; for the pressure the copy p_g = p_0 (homogeneous Neumann).
 // So the kernels read the same values on the slabs as on the whole grid.
 // Collective: every process calls exchange() for the same layouts in the same order.
-// Verified by: the tests ParallelFluidStep.* (tests/test_parallel_fluid_step.cpp, 1, 2 and 3 processes).
+// Verified by: the tests HaloExchange.* and ParallelFluidStep.* (tests/test_parallel_fluid_step.cpp, 1, 2 and 3
+// processes).
 #include <array>
 
 #include "immerse/core/Array3.hpp"

@@ -30,7 +30,8 @@ SlabDecomposition::SlabDecomposition(const Grid& grid, Communicator comm)
   const int needed = grid_.periodic(2) ? 1 : 2;
   if (last_cells < needed)
     throw std::invalid_argument("SlabDecomposition: " + std::to_string(size_) + " processes for " + std::to_string(nz) +
-                                " cell planes along z leave the last process " + std::to_string(std::max(last_cells, 0)) +
+                                " cell planes along z leave the last process " +
+                                std::to_string(std::max(last_cells, 0)) +
                                 " (blocks of " + std::to_string(block_) + "); every process needs at least " +
                                 std::to_string(needed) + (grid_.periodic(2) ? "" : " between walls along z"));
 }

@@ -17,7 +17,8 @@
 // them (HaloExchange fills it); the one plane left over (z1 + 1 for cell layouts, z0 − 1 for u_z on a wall axis) is
 // not used. held(layout) are the planes of the layout's global array that scatter() writes and gather() collects:
 // the owned ones, plus the wall faces of u_z (0 on the first process, N_z on the last) on a wall axis.
-// Verified by: the tests ParallelFluidStep.* (tests/test_parallel_fluid_step.cpp, 1, 2 and 3 processes).
+// Verified by: the tests HaloExchange.* (scatter and gather) and ParallelFluidStep.*
+// (tests/test_parallel_fluid_step.cpp, 1, 2 and 3 processes).
 #include <array>
 
 #include "immerse/core/Array3.hpp"
