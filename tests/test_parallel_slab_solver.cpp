@@ -220,3 +220,50 @@ TEST(SlabFftHelmholtzSolver, RefusesMoreProcessesThanPlanesAlongZ) {
   for (std::size_t q = 0; q < solution.size(); ++q) difference = std::max(difference, std::abs(solution[q] - x[q]));
   EXPECT_LE(difference, 1e-12 * max_abs(x));
 }
+
+// A given block B of planes per process (the fluid's cell block): process r owns the planes [r B, (r + 1) B) of
+// unknowns, here u_z between z walls with 10 planes and B = ⌈11 / P⌉, and solves on them inside a larger array.
+// Blocks that do not cover the planes are refused.
+TEST(SlabFftHelmholtzSolver, AGivenBlockOfPlanesGivesThatDistributionAndTheSerialSolution) {
+  const Communicator comm = Communicator::world();
+  const int p = comm.size(), r = comm.rank();
+  const Grid g({12, 10, 11}, {1.2, 1.0, 1.1}, {P, W, W});
+  const int block = (11 + p - 1) / p;
+  SlabFftHelmholtzSolver slab(g, Layout::VelocityZ, comm, block);
+  EXPECT_EQ(slab.first_plane(), std::min(r * block, 10));
+  EXPECT_EQ(slab.local_planes(), std::max(std::min((r + 1) * block, 10) - r * block, 0));
+  FftHelmholtzSolver serial(g, Layout::VelocityZ, FftPlanning::Estimate);
+  const Array3 x = random_unknowns(g, Layout::VelocityZ, 11u);
+  Array3 b;
+  apply_operator(g, Layout::VelocityZ, x, 1.0, -0.3, b);
+  Array3 expected = b;
+  serial.solve(expected, 1.0, -0.3);
+  // The slab with a plane of 7s below and above it, which the solve leaves as they are.
+  const Array3 inner = slab_of(slab, b);
+  Array3 padded(inner.nx(), inner.ny(), inner.nz() + 2, 7.0);
+  for (int k = 0; k < inner.nz(); ++k)
+    for (int j = 0; j < inner.ny(); ++j)
+      for (int i = 0; i < inner.nx(); ++i) padded(i, j, k + 1) = inner(i, j, k);
+  slab.solve(padded, 1, 1.0, -0.3);
+  Array3 local = inner;
+  for (int k = 0; k < inner.nz(); ++k)
+    for (int j = 0; j < inner.ny(); ++j)
+      for (int i = 0; i < inner.nx(); ++i) local(i, j, k) = padded(i, j, k + 1);
+  for (int k : {0, inner.nz() + 1})
+    for (int j = 0; j < inner.ny(); ++j)
+      for (int i = 0; i < inner.nx(); ++i) EXPECT_EQ(padded(i, j, k), 7.0);
+  const Array3 solution = gather(slab, local, b);
+  double difference = 0;
+  for (std::size_t q = 0; q < solution.size(); ++q)
+    difference = std::max(difference, std::abs(solution[q] - expected[q]));
+  EXPECT_LE(difference, 1e-12 * max_abs(expected));
+  for (int bad : {0, 1}) {  // no block; 1 plane each does not cover 10 planes with at most 3 processes
+    try {
+      SlabFftHelmholtzSolver refused(g, Layout::VelocityZ, comm, bad);
+      ADD_FAILURE() << "a solver with blocks of " << bad << " planes was made";
+    } catch (const std::invalid_argument& e) {
+      EXPECT_NE(std::string(e.what()).find(bad == 0 ? "at least 1" : "do not cover the 10 planes"), std::string::npos)
+          << e.what();
+    }
+  }
+}

@@ -15,10 +15,20 @@ namespace immerse {
 
 SlabFftHelmholtzSolver::SlabFftHelmholtzSolver(const Grid& grid, Layout layout, Communicator comm)
     : layout_(layout), comm_(comm) {
-  shape_ = layout == Layout::Pressure ? grid.cell_shape() : grid.face_shape(static_cast<int>(layout));
+  plan(grid, 0);
+}
+
+SlabFftHelmholtzSolver::SlabFftHelmholtzSolver(const Grid& grid, Layout layout, Communicator comm, int block)
+    : layout_(layout), comm_(comm) {
+  if (block < 1) throw std::invalid_argument("SlabFftHelmholtzSolver: the block of planes must be at least 1");
+  plan(grid, block);
+}
+
+void SlabFftHelmholtzSolver::plan(const Grid& grid, int block) {
+  shape_ = layout_ == Layout::Pressure ? grid.cell_shape() : grid.face_shape(static_cast<int>(layout_));
   std::array<fftw_r2r_kind, 3> fwd{}, bwd{};
   for (int a = 0; a < 3; ++a) {
-    FftAxis axis = fft_axis(grid, layout, a);
+    FftAxis axis = fft_axis(grid, layout_, a);
     m_[a] = axis.count;
     lo_[a] = axis.first;
     fwd[a] = axis.forward;
@@ -27,7 +37,11 @@ SlabFftHelmholtzSolver::SlabFftHelmholtzSolver(const Grid& grid, Layout layout, 
     lambda_[a] = std::move(axis.lambda);
   }
   const int processes = comm_.size();
-  if (processes > m_[2])
+  if (block > 0 && static_cast<long>(block) * processes < m_[2])
+    throw std::invalid_argument("SlabFftHelmholtzSolver: " + std::to_string(processes) + " blocks of " +
+                                std::to_string(block) + " planes do not cover the " + std::to_string(m_[2]) +
+                                " planes of unknowns along z");
+  if (block == 0 && processes > m_[2])
     throw std::invalid_argument("SlabFftHelmholtzSolver: " + std::to_string(processes) + " processes for " +
                                 std::to_string(m_[2]) +
                                 " planes of unknowns along z (the slab axis): use at most one process per plane");
@@ -37,13 +51,16 @@ SlabFftHelmholtzSolver::SlabFftHelmholtzSolver(const Grid& grid, Layout layout, 
   fftw_plan_with_nthreads(1);
   // Array3 is x fastest: in FFTW's row-major terms the dimensions are {z, y, x}, z distributed.
   ptrdiff_t local_n0 = 0, local_0_start = 0;
-  const ptrdiff_t alloc = fftw_mpi_local_size_3d(m_[2], m_[1], m_[0], comm_.comm(), &local_n0, &local_0_start);
+  const ptrdiff_t n[3] = {m_[2], m_[1], m_[0]};
+  const ptrdiff_t b = block > 0 ? block : FFTW_MPI_DEFAULT_BLOCK;
+  const ptrdiff_t alloc = fftw_mpi_local_size_many(3, n, 1, b, comm_.comm(), &local_n0, &local_0_start);
   local_planes_ = static_cast<int>(local_n0);
   first_plane_ = static_cast<int>(local_0_start);
   buf_ = fftw_alloc_real(static_cast<std::size_t>(alloc > 0 ? alloc : 1));
   if (buf_ == nullptr) throw std::bad_alloc();
-  forward_ = fftw_mpi_plan_r2r_3d(m_[2], m_[1], m_[0], buf_, buf_, comm_.comm(), fwd[2], fwd[1], fwd[0], FFTW_ESTIMATE);
-  backward_ = fftw_mpi_plan_r2r_3d(m_[2], m_[1], m_[0], buf_, buf_, comm_.comm(), bwd[2], bwd[1], bwd[0], FFTW_ESTIMATE);
+  const fftw_r2r_kind fk[3] = {fwd[2], fwd[1], fwd[0]}, bk[3] = {bwd[2], bwd[1], bwd[0]};
+  forward_ = fftw_mpi_plan_many_r2r(3, n, 1, b, b, buf_, buf_, comm_.comm(), fk, FFTW_ESTIMATE);
+  backward_ = fftw_mpi_plan_many_r2r(3, n, 1, b, b, buf_, buf_, comm_.comm(), bk, FFTW_ESTIMATE);
   if (forward_ == nullptr || backward_ == nullptr) {
     if (forward_) fftw_destroy_plan(forward_);
     if (backward_) fftw_destroy_plan(backward_);
@@ -70,14 +87,20 @@ void SlabFftHelmholtzSolver::set_symbol(double alpha, double beta) {
 }
 
 void SlabFftHelmholtzSolver::solve(Array3& x, double alpha, double beta) {
+  if (x.nz() != local_planes_)
+    throw std::logic_error("SlabFftHelmholtzSolver::solve: the array is not this process's slab (local_shape())");
+  solve(x, 0, alpha, beta);
+}
+
+void SlabFftHelmholtzSolver::solve(Array3& x, int plane0, double alpha, double beta) {
   const int mx = m_[0], my = m_[1], nz = local_planes_;
   const int ox = lo_[0], oy = lo_[1];
-  if (x.nx() != shape_[0] || x.ny() != shape_[1] || x.nz() != nz)
-    throw std::logic_error("SlabFftHelmholtzSolver::solve: the array is not this process's slab (local_shape())");
+  if (x.nx() != shape_[0] || x.ny() != shape_[1] || plane0 < 0 || x.nz() < plane0 + nz)
+    throw std::logic_error("SlabFftHelmholtzSolver::solve: the array does not hold this process's planes");
   double* const b = buf_;
   for (int k = 0; k < nz; ++k)
     for (int j = 0; j < my; ++j)
-      for (int i = 0; i < mx; ++i) b[i + mx * (j + my * static_cast<std::size_t>(k))] = x(i + ox, j + oy, k);
+      for (int i = 0; i < mx; ++i) b[i + mx * (j + my * static_cast<std::size_t>(k))] = x(i + ox, j + oy, k + plane0);
   if (!(alpha == alpha_ && beta == beta_)) set_symbol(alpha, beta);
   fftw_execute(forward_);
   const double* const inv = inverse_.data();
@@ -86,7 +109,7 @@ void SlabFftHelmholtzSolver::solve(Array3& x, double alpha, double beta) {
   fftw_execute(backward_);
   for (int k = 0; k < nz; ++k)
     for (int j = 0; j < my; ++j)
-      for (int i = 0; i < mx; ++i) x(i + ox, j + oy, k) = b[i + mx * (j + my * static_cast<std::size_t>(k))];
+      for (int i = 0; i < mx; ++i) x(i + ox, j + oy, k + plane0) = b[i + mx * (j + my * static_cast<std::size_t>(k))];
 }
 
 }  // namespace immerse

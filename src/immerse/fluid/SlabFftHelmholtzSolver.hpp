@@ -16,7 +16,9 @@
 // The forward 3D r2r transform (fftw_mpi_plan_r2r_3d, FFTW_ESTIMATE: the same plan on every run) returns the
 // coefficients in the same distribution, so each process divides its planes k by the symbol at global k = z0_r + k.
 // FFTW-MPI transposes through an internal buffer of fftw_mpi_local_size_3d values, which can exceed n_r M_y M_x.
-// More processes than planes (P > M_z) is refused (std::invalid_argument).
+// More processes than planes (P > M_z) is refused (std::invalid_argument). A caller that shares planes between
+// layouts may instead give the block size B itself: process r then owns the planes [r B, min((r + 1) B, M_z)) (FFTW's
+// block distribution with that block; possibly none), for any B with P B ≥ M_z.
 //
 // One thread per process; FFTW-MPI's functions need fftw_mpi_init() (called here, once per process suffices) after
 // MPI_Init, and the program calls fftw_mpi_cleanup() before MPI_Finalize, after the last solver is destroyed.
@@ -41,6 +43,9 @@ class SlabFftHelmholtzSolver {
   /// Plans the distributed transforms of `layout` on `grid` (collective over `comm`). Throws std::invalid_argument
   /// when `comm` has more processes than the layout has planes of unknowns along z.
   SlabFftHelmholtzSolver(const Grid& grid, Layout layout, Communicator comm);
+  /// The same with `block` planes per process (the last ones fewer or none); std::invalid_argument unless
+  /// block ≥ 1 and block · P ≥ M_z.
+  SlabFftHelmholtzSolver(const Grid& grid, Layout layout, Communicator comm, int block);
   ~SlabFftHelmholtzSolver();
   SlabFftHelmholtzSolver(const SlabFftHelmholtzSolver&) = delete;
   SlabFftHelmholtzSolver& operator=(const SlabFftHelmholtzSolver&) = delete;
@@ -48,6 +53,9 @@ class SlabFftHelmholtzSolver {
   /// Overwrites this process's slab x (shape local_shape()) with its part of the solution of (α I + β ∇_h²) x = b,
   /// b being the values of the slabs on entry. Collective. Wall faces along x or y of the slab are untouched.
   void solve(Array3& x, double alpha, double beta);
+  /// The same on planes [plane0, plane0 + local_planes()) of x, an array with the slab's x and y extent and any
+  /// further planes (ghost planes), which are untouched.
+  void solve(Array3& x, int plane0, double alpha, double beta);
 
   Layout layout() const { return layout_; }
   const Communicator& communicator() const { return comm_; }
@@ -63,6 +71,8 @@ class SlabFftHelmholtzSolver {
   int first_array_plane() const { return lo_[2] + first_plane_; }
 
  private:
+  /// Plans with FFTW's default block (block = 0) or the given one.
+  void plan(const Grid& grid, int block);
   /// Tabulates 1 / ((α + β Σλ) N) (0 for a zero denominator) for the local planes.
   void set_symbol(double alpha, double beta);
 

@@ -1,0 +1,218 @@
+#include "immerse/fluid/SlabNavierStokesSolver.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstddef>
+#include <stdexcept>
+
+#include "immerse/core/Error.hpp"
+#include "immerse/fluid/MacStencil_K.hpp"
+#include "immerse/fluid/NavierStokesSolver.hpp"
+
+namespace immerse {
+
+using namespace step_kernels;
+
+namespace {
+
+/// (12) over the rows of `box` of component D: u^{n+1} = u* − (Δt/ρ) G φ.
+template <int D>
+void project(const MacStencilGrid& g, const IndexBox& box, const Array3& us, const Array3& phi, Array3& un1,
+             double dt_rho) {
+  for_each_row(g, box, [&](int j, int k, int i0, int i1) {
+    if (mac::row_wraps(g, j, k))
+      project_row<D, mac::WrappedRows>(g, us, phi, un1, j, k, i0, i1, dt_rho);
+    else
+      project_row<D, mac::Strided>(g, us, phi, un1, j, k, i0, i1, dt_rho);
+  });
+}
+
+}  // namespace
+
+SlabNavierStokesSolver::SlabNavierStokesSolver(const Grid& grid, const FluidParams& params, Communicator comm)
+    : grid_(grid),
+      params_(params),
+      slabs_(grid, comm),
+      halo_(slabs_, params.wall_lower[2], params.wall_upper[2]),
+      geom_(grid, params),
+      local_(geom_) {
+  params_.validate(grid_);
+  if (params_.variable_viscosity)
+    throw std::invalid_argument(
+        "SlabNavierStokesSolver: a variable viscosity is not distributed yet (use NavierStokesSolver)");
+  local_.n[2] = slabs_.local_shape(Layout::Pressure)[2];
+  local_.periodic[2] = true;
+  const int off = slabs_.offset();
+  for (int d = 0; d < 3; ++d) {
+    const PlaneRange own = slabs_.owned(velocity_layout(d));
+    IndexBox all = face_box(geom_, d), fast = interior_face_box(geom_, d);
+    all.begin[2] = own.begin - off;
+    all.end[2] = own.end - off;
+    // The row kernels on the owned planes away from the walls along z; the generic ones (with wall sources) there.
+    const int fb = std::max(fast.begin[2], own.begin), fe = std::max(std::min(fast.end[2], own.end), fb);
+    fast.begin[2] = fb - off;
+    fast.end[2] = fe - off;
+    region_[d] = BuildRegion{all, fast, &geom_, off};
+  }
+  for (int l = 0; l < 4; ++l) {
+    const Layout layout = static_cast<Layout>(l);
+    solvers_[l] = std::make_unique<SlabFftHelmholtzSolver>(grid_, layout, comm, slabs_.block());
+    const PlaneRange own = slabs_.owned(layout);
+    if (solvers_[l]->first_array_plane() != own.begin || solvers_[l]->local_planes() != own.count())
+      throw std::logic_error("SlabNavierStokesSolver: a fast solver's planes are not the decomposition's");
+  }
+  for (int d = 0; d < 3; ++d) ustar_[d] = slabs_.make(velocity_layout(d));
+  div_ = slabs_.make(Layout::Pressure);
+  phi_ = slabs_.make(Layout::Pressure);
+}
+
+bool SlabNavierStokesSolver::is_slab(const FaceField& f) const {
+  for (int d = 0; d < 3; ++d)
+    if (f[d].shape() != slabs_.local_shape(velocity_layout(d))) return false;
+  return true;
+}
+
+void SlabNavierStokesSolver::check(const FluidState& in, double dt, const FaceField& force) const {
+  if (!(std::isfinite(dt) && dt > 0)) require(false, "fluid.dt", dt, "> 0");
+  const std::array<int, 3> cells = slabs_.local_shape(Layout::Pressure);
+  if (!is_slab(in.u) || in.p.shape() != cells || in.p_prev.shape() != cells || (in.step > 0 && !is_slab(in.adv)))
+    throw std::invalid_argument("SlabNavierStokesSolver: state is not a slab state of this decomposition");
+  if (!is_slab(force))
+    throw std::invalid_argument("SlabNavierStokesSolver::step: force is not a slab field of this decomposition");
+}
+
+void SlabNavierStokesSolver::ensure_slabs(FluidState& s) const {
+  for (FaceField* f : {&s.u, &s.adv})
+    if (!is_slab(*f))
+      for (int d = 0; d < 3; ++d) (*f)[d] = slabs_.make(velocity_layout(d));
+  for (Array3* a : {&s.p, &s.p_prev})
+    if (a->shape() != slabs_.local_shape(Layout::Pressure)) *a = slabs_.make(Layout::Pressure);
+}
+
+void SlabNavierStokesSolver::apply_wall_values(FaceField& u) const {
+  for (int d = 0; d < 2; ++d) {
+    if (grid_.periodic(d)) continue;
+    Array3& ud = u[d];
+    for (int k = 0; k < ud.nz(); ++k)
+      for (int j = 0; j < ud.ny(); ++j)
+        for (int i = 0; i < ud.nx(); ++i) {
+          const int q = d == 0 ? i : j;
+          if (q == 0) ud(i, j, k) = params_.wall_lower[d][d];
+          if (q == grid_.n(d)) ud(i, j, k) = params_.wall_upper[d][d];
+        }
+  }
+}
+
+void SlabNavierStokesSolver::step(const FluidState& in, const FaceField& force, double dt, FluidState& out) {
+  check(in, dt, force);
+  if (&in == &out) throw std::invalid_argument("SlabNavierStokesSolver::step: `in` and `out` must be different states");
+  ensure_slabs(out);
+  out.adv_of = 0;
+  const int off = slabs_.offset();
+
+  // The pressure of (9): p^{n−1/2} or p̃, over the whole slab (the ghosts of p and p_prev are valid).
+  const Array3* p = &in.p;
+  if (params_.pressure == PressurePredictor::Extrapolated) {
+    const double w = extrapolation_weight(dt, in.dt_prev, in.dt_prev2);
+    if (w != 0.0) {
+      if (ptilde_.shape() != in.p.shape()) ptilde_ = slabs_.make(Layout::Pressure);
+      for (std::size_t q = 0; q < in.p.size(); ++q) ptilde_[q] = in.p[q] + w * (in.p[q] - in.p_prev[q]);
+      p = &ptilde_;
+    }
+  }
+
+  // (9): the right-hand side on the owned faces and (u·∇_h u)^n into the new state, then the three solves.
+  const double rho = params_.rho, mu = params_.mu;
+  const double c = mu * dt / (2.0 * rho);
+  const double dt_rho = dt / rho;
+  for (int d = 0; d < 3; ++d) {
+    build<true>(local_, region_[d], d, in, *p, &force[d], rhs_coefficients(params_, in, dt, d), out.adv[d],
+                ustar_[d]);
+    solvers_[d]->solve(ustar_[d], slabs_.owned(velocity_layout(d)).begin - off, 1.0, -c);
+  }
+  apply_wall_values(ustar_);
+  halo_.exchange(ustar_[2], Layout::VelocityZ);  // D u* reads u*_z on both sides of the owned cells
+
+  // (11): ∇_h² φ = (ρ/Δt) D u* on the owned cells.
+  const double rho_dt = rho / dt;
+  const PlaneRange cells = slabs_.cells();
+  const IndexBox cell_box{{0, 0, cells.begin - off}, {grid_.n(0), grid_.n(1), cells.end - off}};
+  for_each_row(local_, cell_box, [&](int j, int k, int i0, int i1) {
+    if (mac::row_wraps(local_, j, k))
+      divergence_row<mac::WrappedRows>(local_, ustar_, rho_dt, div_, phi_, j, k, i0, i1);
+    else
+      divergence_row<mac::Strided>(local_, ustar_, rho_dt, div_, phi_, j, k, i0, i1);
+  });
+  solvers_[3]->solve(phi_, cells.begin - off, 0.0, 1.0);
+  halo_.exchange(phi_, Layout::Pressure);  // G φ reads φ below (and, for u_z between walls, above) the owned faces
+
+  // (12) and (13).
+  project<0>(local_, region_[0].all, ustar_[0], phi_, out.u[0], dt_rho);
+  project<1>(local_, region_[1].all, ustar_[1], phi_, out.u[1], dt_rho);
+  project<2>(local_, region_[2].all, ustar_[2], phi_, out.u[2], dt_rho);
+  const double half_mu = 0.5 * mu;
+  for (int k = cell_box.begin[2]; k < cell_box.end[2]; ++k) {
+    const std::size_t o = phi_.index(0, 0, k);
+    const std::size_t n = static_cast<std::size_t>(grid_.n(0)) * grid_.n(1);
+    for (std::size_t q = o; q < o + n; ++q) out.p[q] = (*p)[q] + phi_[q] - half_mu * div_[q];
+  }
+  out.p_prev.values() = in.p.values();  // with its ghosts
+  apply_wall_values(out.u);
+  for (int d = 0; d < 3; ++d) halo_.exchange(out.u[d], velocity_layout(d));
+  halo_.exchange(out.p, Layout::Pressure);
+
+  out.dt_prev2 = in.dt_prev;
+  out.dt_prev = dt;
+  out.step = in.step + 1;
+  out.time = in.time + dt;
+}
+
+void SlabNavierStokesSolver::exchange_ghosts(FluidState& s) const {
+  for (int d = 0; d < 3; ++d) halo_.exchange(s.u[d], velocity_layout(d));
+  halo_.exchange(s.p, Layout::Pressure);
+  halo_.exchange(s.p_prev, Layout::Pressure);
+}
+
+FluidState SlabNavierStokesSolver::scatter(const FluidState& global) const {
+  FluidState s;
+  ensure_slabs(s);
+  for (int d = 0; d < 3; ++d) {
+    slabs_.scatter(global.u[d], velocity_layout(d), s.u[d]);
+    if (global.adv[d].shape() == grid_.face_shape(d)) slabs_.scatter(global.adv[d], velocity_layout(d), s.adv[d]);
+  }
+  slabs_.scatter(global.p, Layout::Pressure, s.p);
+  if (global.p_prev.shape() == grid_.cell_shape()) slabs_.scatter(global.p_prev, Layout::Pressure, s.p_prev);
+  s.dt_prev = global.dt_prev;
+  s.dt_prev2 = global.dt_prev2;
+  s.step = global.step;
+  s.time = global.time;
+  exchange_ghosts(s);
+  return s;
+}
+
+FaceField SlabNavierStokesSolver::scatter(const FaceField& global) const {
+  FaceField f;
+  for (int d = 0; d < 3; ++d) slabs_.scatter(global[d], velocity_layout(d), f[d]);
+  return f;
+}
+
+FluidState SlabNavierStokesSolver::gather(const FluidState& local) const {
+  FluidState s;
+  s.u = gather(local.u);
+  s.adv = gather(local.adv);
+  s.p = slabs_.gather(local.p, Layout::Pressure);
+  s.p_prev = slabs_.gather(local.p_prev, Layout::Pressure);
+  s.dt_prev = local.dt_prev;
+  s.dt_prev2 = local.dt_prev2;
+  s.step = local.step;
+  s.time = local.time;
+  return s;
+}
+
+FaceField SlabNavierStokesSolver::gather(const FaceField& local) const {
+  FaceField f;
+  for (int d = 0; d < 3; ++d) f[d] = slabs_.gather(local[d], velocity_layout(d));
+  return f;
+}
+
+}  // namespace immerse
