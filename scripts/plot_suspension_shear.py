@@ -48,15 +48,16 @@ def read_run(run_dir, from_kt):
     kt, eta = d["kt"], d["relative_viscosity"]
     start = 0.5 * kt[-1] if from_kt is None else from_kt
     window = kt >= start
-    if window.sum() < 8:
-        pc.fail(f"{run_dir}: {window.sum()} rows with k t >= {start:g}; at least 8 are needed (run longer or lower "
+    if window.sum() < 4:
+        pc.fail(f"{run_dir}: {window.sum()} rows with k t >= {start:g}; at least 4 are needed (run longer or lower "
                 "--from-kt)")
     blocks = np.array_split(eta[window], 4)
     means = np.array([b.mean() for b in blocks])
     m = cfg["membrane"][0] if cfg.get("membrane") else {}
     return {"dir": run_dir, "H": float(d["volume_fraction"].mean()), "kt": kt, "eta": eta, "start": start,
             "mean": float(eta[window].mean()), "sem": float(means.std(ddof=1) / np.sqrt(len(means))),
-            "gap_um": cfg["domain"]["Lz"] * 1e6, "cells": len(cfg.get("membrane", [])),
+            "gap_um": cfg["domain"]["Lz"] * 1e6,
+            "cells": sum(1 for n in d if n.startswith("m") and n.endswith("_volume")) or ("volume" in d),
             "lambda": m.get("viscosity_ratio", 1.0), "resolution": pc.resolution_of(cfg) if m else ""}
 
 

@@ -54,10 +54,19 @@ int TimeLoop::run() {
     throw;
   }
   progress_.finish();
-  // A failure to save the last state is a failed write too (exit 5).
+  // A failure to save the last state is a failed write too (exit 5). A last state the membranes cannot be evaluated
+  // in (an element that a volume correction turned over, say) loses the output that needs its forces, not the rest:
+  // the checkpoint is still written and the run counts as stopped by the numerics (exit 3).
   if (status_ != 5) try {
-      for (auto& c : callbacks_)
-        if (c.at_end && c.last_step != sim_.step()) c.run(sim_, sim_.step());
+      for (auto& c : callbacks_) {
+        if (!c.at_end || c.last_step == sim_.step()) continue;
+        try {
+          c.run(sim_, sim_.step());
+        } catch (const SimulationError& e) {
+          err_ << "immerse: " << c.name << " of step " << sim_.step() << " not written: " << e.what() << "\n";
+          status_ = 3;
+        }
+      }
     } catch (const WriteError& e) {
       write_failed(e);
     }
