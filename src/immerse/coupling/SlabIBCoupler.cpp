@@ -109,15 +109,19 @@ void SlabIBCoupler::gather_ranges() {
   for (std::size_t q = 0; q < all_ranges_.size(); ++q) all_ranges_[q] = {all[2 * q], all[2 * q + 1]};
 }
 
-int SlabIBCoupler::plane_values(int from, int to) const {
-  int count = 0;
+void SlabIBCoupler::count_planes(std::vector<int>& mine, std::vector<int>& theirs) const {
+  mine.assign(size_, 0);
+  theirs.assign(size_, 0);
   for (int d = 0; d < 3; ++d) {
-    const Range& r = all_ranges_[static_cast<std::size_t>(3) * from + d];
+    const Layout layout = velocity_layout(d);
     const int per_plane = static_cast<int>(plane_size(buffer_[d]));
-    for (int q = r.begin; q < r.end; ++q)
-      if (slabs_.holder(velocity_layout(d), wrap(d, q)) == to) count += per_plane;
+    for (int q = range_[d].begin; q < range_[d].end; ++q) mine[slabs_.holder(layout, wrap(d, q))] += per_plane;
+    for (int r = 0; r < size_; ++r) {
+      const Range& range = all_ranges_[static_cast<std::size_t>(3) * r + d];
+      for (int q = range.begin; q < range.end; ++q)
+        if (slabs_.holder(layout, wrap(d, q)) == rank_) theirs[r] += per_plane;
+    }
   }
-  return count;
 }
 
 void SlabIBCoupler::check_slab(const FaceField& field, const char* what) const {
@@ -161,14 +165,11 @@ void SlabIBCoupler::spread_force(std::span<const Vec3> X, std::span<const Vec3> 
       },
       kernel_);
   // Each plane of the buffers to its holder, in the order (holder, component, plane).
-  std::vector<int> send_counts(size_), send_offsets(size_, 0), recv_counts(size_), recv_offsets(size_, 0);
-  for (int r = 0; r < size_; ++r) {
-    send_counts[r] = plane_values(rank_, r);
-    recv_counts[r] = plane_values(r, rank_);
-    if (r > 0) {
-      send_offsets[r] = send_offsets[r - 1] + send_counts[r - 1];
-      recv_offsets[r] = recv_offsets[r - 1] + recv_counts[r - 1];
-    }
+  std::vector<int> send_counts, send_offsets(size_, 0), recv_counts, recv_offsets(size_, 0);
+  count_planes(send_counts, recv_counts);
+  for (int r = 1; r < size_; ++r) {
+    send_offsets[r] = send_offsets[r - 1] + send_counts[r - 1];
+    recv_offsets[r] = recv_offsets[r - 1] + recv_counts[r - 1];
   }
   send_.resize(static_cast<std::size_t>(send_offsets[size_ - 1]) + send_counts[size_ - 1]);
   recv_.resize(static_cast<std::size_t>(recv_offsets[size_ - 1]) + recv_counts[size_ - 1]);
@@ -215,14 +216,11 @@ void SlabIBCoupler::interpolate_velocity(const FaceField& u, std::span<const Vec
   check_nodes_in_domain(grid_, X);
   std::visit([&](const auto& k) { prepare<std::decay_t<decltype(k)>>(X); }, kernel_);
   // The held planes each process's buffers need, to it, in the order (component, plane) of its buffers.
-  std::vector<int> send_counts(size_), send_offsets(size_, 0), recv_counts(size_), recv_offsets(size_, 0);
-  for (int r = 0; r < size_; ++r) {
-    send_counts[r] = plane_values(r, rank_);
-    recv_counts[r] = plane_values(rank_, r);
-    if (r > 0) {
-      send_offsets[r] = send_offsets[r - 1] + send_counts[r - 1];
-      recv_offsets[r] = recv_offsets[r - 1] + recv_counts[r - 1];
-    }
+  std::vector<int> send_counts, send_offsets(size_, 0), recv_counts, recv_offsets(size_, 0);
+  count_planes(recv_counts, send_counts);
+  for (int r = 1; r < size_; ++r) {
+    send_offsets[r] = send_offsets[r - 1] + send_counts[r - 1];
+    recv_offsets[r] = recv_offsets[r - 1] + recv_counts[r - 1];
   }
   send_.resize(static_cast<std::size_t>(send_offsets[size_ - 1]) + send_counts[size_ - 1]);
   recv_.resize(static_cast<std::size_t>(recv_offsets[size_ - 1]) + recv_counts[size_ - 1]);

@@ -12,9 +12,10 @@
 // Design. A process's nodes may lie anywhere along z (a membrane is owned by the slab of its centroid and may reach
 // into other slabs, on a periodic z across the wrap), so each process spreads into, and interpolates from, a padded
 // buffer per velocity component: the planes along z from the lowest to the highest plane any of its nodes' kernels
-// touch. A node within the owned cell planes [z0, z1) reaches at most 2 planes beyond them with the 3-point and the
-// 4-point kernel (1 below and 2 above for roma3, 2 and 1 for the centres of peskin4), so for membranes inside their
-// slab the buffer is the slab with 2 ghost planes per side; a membrane reaching out of its slab widens it by its reach.
+// touch. A node within the owned cell planes [z0, z1) reaches at most 2 planes beyond them on each side, the kernels'
+// half-width (cell-centred components: roma3 1 plane below and above, peskin4 2; faces of u_z: both kernels from face
+// z0 − 1 to face z1 + 1), so for membranes inside their slab the buffer is the slab with 2 ghost planes per side; a
+// membrane reaching out of its slab widens it by its reach.
 // On a periodic z each node's stencil is taken at the image (z + k L_z, k ∈ {−1, 0, 1}) nearest the centre of the
 // owned planes, so a membrane across the wrap occupies one contiguous range; on a wall axis the buffer is clipped
 // to the stored planes (faces 0 … N_z of u_z, centres 0 … N_z − 1 otherwise), which drops exactly the kernel points
@@ -82,8 +83,9 @@ class SlabIBCoupler {
   void interpolate(std::span<const Vec3> X, std::span<Vec3> U) const;
   /// The global plane of a buffer plane (wrapped on a periodic z).
   int wrap(int d, int plane) const;
-  /// Number of doubles process `from` sends to `to` when spreading (planes of from's buffers held by to).
-  int plane_values(int from, int to) const;
+  /// Per rank r, the doubles of this process's buffer planes held by r (mine[r]) and of r's buffer planes held by
+  /// this process (theirs[r]): what spreading sends to and receives from r (interpolation: the reverse).
+  void count_planes(std::vector<int>& mine, std::vector<int>& theirs) const;
   void check_slab(const FaceField& field, const char* what) const;
 
   const SlabDecomposition& slabs_;
