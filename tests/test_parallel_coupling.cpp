@@ -50,7 +50,7 @@ std::vector<Sphere> spheres(const Grid& g) {
   std::vector<Sphere> s{
       {{0.4, 0.3, 0.22}, 0.2},    // reaches within 0.02 of the lower wall
       {{1.0, 0.7, 0.78}, 0.25},   // across z = 0.5 and z = 0.8
-      {{1.45, 0.95, 1.02}, 0.25}, // across the periodic x and y boundaries and z = 1.0
+      {{1.45, 1.0, 1.02}, 0.25},  // across the periodic x and y boundaries, z = 0.8 and z = 1.0
       {{0.3, 0.9, 1.3}, 0.18},    // reaches within 0.02 of the upper wall
   };
   if (g.periodic(2)) {

@@ -8,6 +8,8 @@
 #include <cstddef>
 #include <stdexcept>
 #include <string>
+#include <type_traits>
+#include <variant>
 
 #include "immerse/core/Parallel.hpp"
 #include "immerse/coupling/IBStencil_K.hpp"
@@ -211,7 +213,8 @@ void SlabIBCoupler::spread_force(std::span<const Vec3> X, std::span<const Vec3> 
 }
 
 void SlabIBCoupler::interpolate_velocity(const FaceField& u, std::span<const Vec3> X, std::span<Vec3> U) {
-  if (U.size() != X.size()) throw std::invalid_argument("SlabIBCoupler::interpolate_velocity: X and U differ in length");
+  if (U.size() != X.size())
+    throw std::invalid_argument("SlabIBCoupler::interpolate_velocity: X and U differ in length");
   check_slab(u, "the velocity field");
   check_nodes_in_domain(grid_, X);
   std::visit([&](const auto& k) { prepare<std::decay_t<decltype(k)>>(X); }, kernel_);
