@@ -494,3 +494,37 @@ TEST(ParallelCoupling, ProcessesWithoutMembranes) {
     EXPECT_TRUE(bitwise_equal(ownership.gather(Uo), U_serial));
   }
 }
+
+// The ghost width: nodes anywhere in the owned cell planes [z0, z1) need the planes of cell centres
+// [z0 − 1, z1 + 1) (roma3) or [z0 − 2, z1 + 2) (peskin4) and the faces of u_z [z0 − 1, z1 + 2) (both), at most 2
+// planes beyond the owned ones on each side, clipped to the stored planes between walls.
+TEST(ParallelCoupling, GhostWidthOfNodesInsideTheSlab) {
+  const Communicator comm = Communicator::world();
+  for (Boundary z : {W, P})
+    for (const DeltaKernel& kernel : {DeltaKernel(RomaPeskin3{}), DeltaKernel(Peskin4{})}) {
+      const Grid g = grid_with(z);
+      const SlabDecomposition slabs(g, comm);
+      const PlaneRange cells = slabs.cells();
+      std::vector<Vec3> X;
+      for (double t = cells.begin; t < cells.end; t += 0.125) X.push_back({0.37, 0.51, t * g.h()});
+      X.push_back({0.37, 0.51, (cells.end - 1e-9) * g.h()});
+      SlabIBCoupler coupler(slabs, kernel);
+      FaceField f;
+      coupler.spread_force(X, std::vector<Vec3>(X.size()), f);
+      const int wc = kernel_width(kernel) == 3 ? 1 : 2;
+      for (int d = 0; d < 3; ++d) {
+        PlaneRange expected = d < 2 ? PlaneRange{cells.begin - wc, cells.end + wc}
+                                    : PlaneRange{cells.begin - 1, cells.end + 2};
+        if (z == W) {
+          expected.begin = std::max(expected.begin, 0);
+          expected.end = std::min(expected.end, g.face_shape(d)[2]);
+        }
+        const PlaneRange got = coupler.buffer_planes(d);
+        EXPECT_EQ(got.begin, expected.begin) << kernel_name(kernel) << ", component " << d;
+        EXPECT_EQ(got.end, expected.end) << kernel_name(kernel) << ", component " << d;
+        const PlaneRange owned = slabs.owned(velocity_layout(d));
+        EXPECT_GE(got.begin, owned.begin - 2);
+        EXPECT_LE(got.end, owned.end + 2);
+      }
+    }
+}

@@ -37,7 +37,8 @@
 // any sum). Both methods are collective over the decomposition's communicator.
 // Verified by: the tests ParallelCoupling.* (tests/test_parallel_coupling.cpp, run with 1, 2 and 3 processes: spreading
 // and interpolation gathered from the processes against IBCoupler within 1e-12, the adjoint identity, repeated
-// calls bitwise equal, and a coupled forward Euler step against the serial one).
+// calls bitwise equal, the ghost width of nodes inside the slab, and coupled forward Euler steps against the serial
+// ones).
 #include <array>
 #include <span>
 #include <vector>
@@ -66,6 +67,9 @@ class SlabIBCoupler {
   /// Collective.
   void interpolate_velocity(const FaceField& u, std::span<const Vec3> X, std::span<Vec3> U);
 
+  /// The planes along z (global indices, unwrapped on a periodic z) of the padded buffer of velocity component d in
+  /// the last call: the ghost width that call needed.
+  PlaneRange buffer_planes(int d) const { return {range_[d].begin, range_[d].end}; }
   const SlabDecomposition& decomposition() const { return slabs_; }
   const DeltaKernel& kernel() const { return kernel_; }
 
