@@ -50,6 +50,15 @@ PlaneRange SlabDecomposition::held(Layout layout) const {
   return r;
 }
 
+int SlabDecomposition::holder(Layout layout, int plane) const {
+  const int planes = global_shape(grid_, layout)[2];
+  if (plane < 0 || plane >= planes)
+    throw std::out_of_range("SlabDecomposition::holder: plane " + std::to_string(plane) + " of " +
+                            std::to_string(planes));
+  if (normal_to_z_walls(grid_, layout)) return plane == 0 ? 0 : (plane - 1) / block_;  // faces z0 + 1 … z1
+  return plane / block_;
+}
+
 std::array<int, 3> SlabDecomposition::local_shape(Layout layout) const {
   const std::array<int, 3> s = global_shape(grid_, layout);
   return {s[0], s[1], z1_ - z0_ + 3};

@@ -16,9 +16,10 @@
 // so the MAC kernels index all layouts' slabs alike). They hold the owned planes and one ghost plane on each side of
 // them (HaloExchange fills it); the one plane left over (z1 + 1 for cell layouts, z0 − 1 for u_z on a wall axis) is
 // not used. held(layout) are the planes of the layout's global array that scatter() writes and gather() collects:
-// the owned ones, plus the wall faces of u_z (0 on the first process, N_z on the last) on a wall axis.
+// the owned ones, plus the wall faces of u_z (0 on the first process, N_z on the last) on a wall axis; holder() names
+// the process holding a given plane, so every plane of every layout has exactly one.
 // Verified by: the tests HaloExchange.* (scatter and gather) and ParallelFluidStep.*
-// (tests/test_parallel_fluid_step.cpp, 1, 2 and 3 processes).
+// (tests/test_parallel_fluid_step.cpp, 1, 2 and 3 processes), and ParallelCoupling.HolderOfEveryPlane (holder()).
 #include <array>
 
 #include "immerse/core/Array3.hpp"
@@ -49,6 +50,8 @@ class SlabDecomposition {
   PlaneRange owned(Layout layout) const;
   /// The planes of the global array of `layout` that this process scatters and gathers.
   PlaneRange held(Layout layout) const;
+  /// The rank whose held(layout) contains the global plane `plane` (0 ≤ plane < the layout's planes along z).
+  int holder(Layout layout, int plane) const;
   /// Global index of local plane 0 of every slab array.
   int offset() const { return z0_ - 1; }
   /// Shape of the slab array of `layout` (layout's x and y extent, z1 − z0 + 3 planes).
