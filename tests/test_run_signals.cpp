@@ -169,3 +169,20 @@ TEST(SignalPipe, ClosedStandardOutputDoesNotKillAVerification) {
   EXPECT_EQ(p.wait(), 0) << p.err();
   EXPECT_EQ(p.err(), "");
 }
+
+// A stop asked for while [packing] places the cells (59 red cells at H = 0.4 in the quick suspension take minutes
+// to place) ends the run at once with status 4, one line, and nothing written.
+TEST(SignalPacking, StopWhilePackingEndsAtOnceWithStatus4AndNothingWritten) {
+  ScratchDir dir("signal");
+  const fs::path out = dir / "out";
+  ImmerseProcess p(run_args(scenario_file("suspension_shear_quick.toml"), out, {"packing.volume_fraction=0.4"}),
+                   dir / "run");
+  std::this_thread::sleep_for(std::chrono::seconds(5));  // past the start-up, well within the packing
+  const auto sent = std::chrono::steady_clock::now();
+  p.signal(SIGTERM);
+  ASSERT_EQ(p.wait(), 4) << p.err();
+  EXPECT_LT(std::chrono::steady_clock::now() - sent, std::chrono::seconds(60));  // the packing alone takes minutes
+  EXPECT_EQ(p.err(), "immerse: interrupted by signal 15 while packing the cells, before the first step; nothing "
+                     "written\n");
+  EXPECT_FALSE(fs::exists(out));
+}

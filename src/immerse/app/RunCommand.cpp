@@ -60,7 +60,7 @@ void check_memory(const io::Config& c) {
 std::unique_ptr<Simulation> build_simulation(const io::Config& config) {
   check_memory(config);
   try {
-    return std::make_unique<Simulation>(config);
+    return std::make_unique<Simulation>(config, [] { return StopSignals::received() != 0; });
   } catch (const std::bad_alloc&) {
     throw InputError(grid_text(config) + ": the fluid and membrane arrays do not fit in this machine's memory");
   }
@@ -127,7 +127,14 @@ int run_command(const RunOptions& options, std::ostream& out, std::ostream& err)
   const io::ConfigSchema schema = run_schema();
   const io::Config config = apply_scenario(schema.parse_file(options.file, options.sets));
   const RunSettings settings = RunSettings::from(config);
-  const std::unique_ptr<Simulation> sim = build_simulation(config);
+  std::unique_ptr<Simulation> sim;
+  try {
+    sim = build_simulation(config);
+  } catch (const StopRequested&) {  // while packing the cells: nothing has been written
+    err << "immerse: interrupted by signal " << StopSignals::received()
+        << " while packing the cells, before the first step; nothing written\n";
+    return 4;
+  }
   const std::unique_ptr<ScenarioRun> scenario = make_scenario_run(config);
   start_or_restore(*sim, *scenario, options.restart);
   const MeshCopies copies = MeshCopies::of(config);

@@ -120,12 +120,13 @@ class Relaxation {
 
   /// Relaxes at size s; true when no two nodes of different copies lie within the clearance and no node within it
   /// of a wall.
-  bool relax(double s) {
+  bool relax(double s, const std::function<bool()>& stop_requested) {
     std::vector<Vec3> v(N_), u(N_), F(N_), G(N_);  // velocities, angular ones times sqrt(I); forces, torques / sqrt(I)
     const double sqrtI = s * std::sqrt(mean_r2_);  // scalar moment of inertia of a unit mass spread over the nodes
     double dt = kFireDt, alpha = kFireAlpha;
     int positive = 0;
     for (int iteration = 0; iteration < kMaxIterations; ++iteration, ++steps_) {
+      if (stop_requested && stop_requested()) throw StopRequested("a stop was requested while packing the cells");
       positions(s);
       if (stale()) rebuild();
       if (forces(F, G, sqrtI)) return true;
@@ -322,7 +323,7 @@ CellPacking::CellPacking(const Grid& grid, const std::vector<Vec3>& shape, doubl
   double growth = std::min(kGrowthMax, kMaxStep * c / R), s_clear = s;  // a growth step moves nodes <= kMaxStep c
   while (true) {
     double next = 1;
-    if (relaxation.relax(s)) {
+    if (relaxation.relax(s, request.stop_requested)) {
       s_clear = s;
       if (s == 1.0) break;
       next = std::min(1.0, s * (1 + growth));

@@ -31,6 +31,7 @@
 // pair within the clearance, no node inside another copy, no elements crossing, bitwise reproducible by seed; a
 // fraction that cannot be reached is refused).
 #include <cstdint>
+#include <functional>
 #include <vector>
 
 #include "immerse/grid/Grid.hpp"
@@ -42,6 +43,8 @@ struct PackingRequest {
   std::size_t count = 0;      ///< copies to place
   std::uint64_t seed = 1;
   double clearance = 0;       ///< least distance between nodes of two copies, and from a node to a wall (m)
+  /// Asked between relaxation steps (when set): true ends the packing with StopRequested, nothing placed.
+  std::function<bool()> stop_requested;
 };
 
 class CellPacking {

@@ -145,7 +145,7 @@ std::string unit_hint(const io::Config& config, std::size_t m) {
 
 }  // namespace
 
-Simulation::Simulation(const io::Config& config)
+Simulation::Simulation(const io::Config& config, const std::function<bool()>& stop_requested)
     : config_(config),
       end_time_(config.get<double>("time.end")),
       max_speed_(config.get<double>("time.max_speed")),
@@ -156,7 +156,7 @@ Simulation::Simulation(const io::Config& config)
       coupler_(grid_, delta_kernel(config.get<std::string>("coupling.kernel"))),
       stepper_(config.get<double>("time.dt"), config.get<double>("time.dt_min")) {
   build_membranes();
-  pack_membranes();
+  pack_membranes(stop_requested);
   check_geometry();
   std::vector<const ElasticMembrane*> ms;
   for (auto& m : membranes_) ms.push_back(m.get());
@@ -247,7 +247,7 @@ void Simulation::add_membrane(const io::Config& m, Mesh mesh, std::vector<Vec3> 
 }
 
 // [packing]: membrane[0] is the template; its copies replace it, placed by CellPacking.
-void Simulation::pack_membranes() {
+void Simulation::pack_membranes(const std::function<bool()>& stop_requested) {
   const double fraction = config_.get<double>("packing.volume_fraction");
   const auto count = config_.get<std::int64_t>("packing.count");
   if (fraction == 0 && count == 0) return;
@@ -287,6 +287,7 @@ void Simulation::pack_membranes() {
   request.seed = static_cast<std::uint64_t>(config_.get<std::int64_t>("packing.seed"));
   const double clearance = config_.get<double>("packing.clearance");
   request.clearance = clearance > 0 ? clearance : 1.1 * grid_.h();
+  request.stop_requested = stop_requested;
   const auto t0 = std::chrono::steady_clock::now();
   const CellPacking packing(grid_, shape, spacing, request, key);
   std::ostringstream summary;

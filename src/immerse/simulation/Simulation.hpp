@@ -2,6 +2,7 @@
 // One run: the grid, the fluid, the membranes, their coupling and the time integrator, built from a resolved
 // configuration (RunSchema), advanced step by step. Output is not its business: run_command (app/RunCommand.hpp)
 // schedules callbacks (diagnostics, ParaView frames, checkpoints, progress) around advance().
+#include <functional>
 #include <memory>
 #include <optional>
 #include <string>
@@ -33,7 +34,8 @@ class Simulation {
  public:
   /// Builds everything from `config` (already through apply_scenario). Throws InputError on inconsistent input
   /// (a membrane outside the box or too close to a wall, two membranes overlapping, bad meshes, ...).
-  explicit Simulation(const io::Config& config);
+  /// `stop_requested`, when given, is asked while [packing] places the cells: true throws StopRequested.
+  explicit Simulation(const io::Config& config, const std::function<bool()>& stop_requested = {});
 
   /// Advances one accepted step (with step halving on failed solves, reported through `log`), then corrects the
   /// volume of the membranes with volume_correction = "normal_shift" (VolumeCorrection.hpp). Throws
@@ -67,7 +69,7 @@ class Simulation {
  private:
   void build_membranes();
   void add_membrane(const io::Config& m, Mesh mesh, std::vector<Vec3> initial, std::vector<Vec3> reference);
-  void pack_membranes();
+  void pack_membranes(const std::function<bool()>& stop_requested);
   FluidState initial_fluid_state() const;
   void check_geometry() const;
   void check_stability(const StepRecord& r) const;
