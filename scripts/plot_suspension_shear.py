@@ -4,9 +4,10 @@
 Usage: /usr/bin/python3 scripts/plot_suspension_shear.py RUN_DIR [RUN_DIR ...] [-o PNG] [--from-kt KT] [--title T]
 Runs of scenarios/suspension_shear.toml or suspension_shear_quick.toml (scenario.kind = "suspension_shear"), one per
 hematocrit. For each run, from diagnostics.csv: the volume fraction H (its mean over the run) and the relative
-viscosity eta_rel = (tau_lower + tau_upper) / (2 mu k), averaged over k t >= KT (default: the second half of the
-run), with the standard error of that mean from the means of four equal blocks of the window (the wall stress is
-correlated over a few shear times, so single steps are not independent samples).
+viscosity eta_rel = (tau_lower + tau_upper) / (2 mu k), averaged in time (trapezoidal weights, so that halved steps
+do not count more) over k t >= KT (default: the second half of the run), with the standard error of that mean from
+the means of four blocks of equal duration (the wall stress is correlated over a few shear times, so single steps
+are not independent samples).
 Beside them, the relative apparent viscosity of human red cells in plasma-like media measured in tubes at high shear
 rates (>= 50 1/s), as fitted by Pries, Neuhaus & Gaehtgens (1992, Am. J. Physiol. 263:H1770):
     eta_rel(H, D) = 1 + (eta_045(D) - 1) ((1 - H)^C - 1) / ((1 - 0.45)^C - 1),
@@ -51,11 +52,19 @@ def read_run(run_dir, from_kt):
     if window.sum() < 4:
         pc.fail(f"{run_dir}: {window.sum()} rows with k t >= {start:g}; at least 4 are needed (run longer or lower "
                 "--from-kt)")
-    blocks = np.array_split(eta[window], 4)
-    means = np.array([b.mean() for b in blocks])
+    t, e = kt[window], eta[window]
+    # Time-weighted (trapezoidal) means: halved steps put rows closer together, not more weight.
+    w = np.ones(1)
+    if len(t) > 1:
+        w = np.zeros(len(t))
+        w[:-1] += 0.5 * np.diff(t)
+        w[1:] += 0.5 * np.diff(t)
+    edges = np.linspace(t[0], t[-1], 5)
+    block = np.minimum(np.searchsorted(edges, t, side="right") - 1, 3)
+    means = np.array([np.average(e[block == b], weights=w[block == b]) for b in range(4) if np.any(block == b)])
     m = cfg["membrane"][0] if cfg.get("membrane") else {}
     return {"dir": run_dir, "H": float(d["volume_fraction"].mean()), "kt": kt, "eta": eta, "start": start,
-            "mean": float(eta[window].mean()), "sem": float(means.std(ddof=1) / np.sqrt(len(means))),
+            "mean": float(np.average(e, weights=w)), "sem": float(means.std(ddof=1) / np.sqrt(len(means))),
             "gap_um": cfg["domain"]["Lz"] * 1e6,
             "cells": sum(1 for n in d if n.startswith("m") and n.endswith("_volume")) or ("volume" in d),
             "lambda": m.get("viscosity_ratio", 1.0), "resolution": pc.resolution_of(cfg) if m else ""}

