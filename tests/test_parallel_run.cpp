@@ -88,6 +88,10 @@ void compare_with_serial(const std::string& scheme, int steps, const std::vector
       for (int k = 0; k < 3; ++k) ASSERT_EQ(a.positions[m][i][k], b.positions[m][i][k]) << "membrane " << m;
   for (int d = 0; d < 3; ++d) ASSERT_EQ(a.fluid.u[d].values(), b.fluid.u[d].values()) << "u_" << d;
   EXPECT_EQ(a.migrations, b.migrations);
+  // The middle layer starts on the slab boundary of 2 and 4 processes: some of its cells change owner.
+  if (comm.size() == 2 || comm.size() == 4) {
+    EXPECT_GT(a.migrations, 0);
+  }
   if (comm.rank() != 0) return;
 
   const auto t0 = std::chrono::steady_clock::now();
@@ -125,12 +129,12 @@ void compare_with_serial(const std::string& scheme, int steps, const std::vector
   }
   const double mean_serial = mean(f.u[1]), mean_distributed = mean(a.fluid.u[1]);
   std::printf(
-      "[ParallelRun] %s%s, %d steps of %g s on %d processes: positions %.2e (relative to the largest coordinate), "
-      "displacements %.2e (relative to the largest, %.3e m), velocity %.2e (relative to the largest), mean u_y %.6e "
-      "m/s vs %.6e m/s (relative difference %.2e); cells that changed owner: %d; distributed %.1f s per run, "
-      "serial %.1f s\n",
-      scheme.c_str(), more.empty() ? "" : (" " + more[0]).c_str(), steps, kDt, comm.size(), dx / x_max, d_moved / moved, moved, du / u_max, mean_distributed,
-      mean_serial, std::abs(mean_distributed - mean_serial) / std::abs(mean_serial), a.migrations, a.seconds,
+      "[ParallelRun] %s%s, %d steps of %g s on %d processes: positions %.2e (relative to the largest "
+      "coordinate), displacements %.2e (relative to the largest, %.3e m), velocity %.2e (relative to the "
+      "largest), mean u_y %.6e m/s vs %.6e m/s (relative difference %.2e); cells that changed owner: %d; "
+      "distributed %.1f s per run, serial %.1f s\n",
+      scheme.c_str(), more.empty() ? "" : (" " + more[0]).c_str(), steps, kDt, comm.size(), dx / x_max,
+      d_moved / moved, moved, du / u_max, mean_distributed, mean_serial, std::abs(mean_distributed - mean_serial) / std::abs(mean_serial), a.migrations, a.seconds,
       serial_seconds);
   EXPECT_GT(moved, 0.0);
   EXPECT_LE(dx / x_max, 1e-10);
