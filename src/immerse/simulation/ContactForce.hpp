@@ -27,7 +27,9 @@
 // then node index): the sums do not depend on the thread count. With no node within d of another membrane or a
 // wall every force is exactly zero, and the run is bitwise that without contact.
 // Verified by tests/test_simulation_contact.cpp (ContactForce.*: gradient, support, third law, walls, neighbour
-// search against brute force; ContactRun.*: two capsules kept apart in shear, an isolated capsule unchanged).
+// search against brute force; ContactRun.*: two capsules kept apart in shear, an isolated capsule unchanged) and
+// ParallelRun.* (bounds(), boxes_within_range() and set_search_nodes() on part of the membranes, in
+// DistributedOperator: the forces of a distributed run equal the one-process run's).
 #include <array>
 #include <cstddef>
 #include <span>
