@@ -197,6 +197,17 @@ TEST(ParallelRun, RedCellChannelWithContactAcrossProcessesEqualsTheOneProcessRun
   compare_with_serial("rk2", kContactSteps, {range});
 }
 
+// A bound on the speed below the flow's: every process stops with a SimulationError (the owners naming the node).
+TEST(ParallelRun, AnUnstableRunStopsOnEveryProcess) {
+  DistributedSimulation sim(channel("rk2", 2, {"time.max_speed=1e-5"}), Communicator::world());
+  try {
+    sim.advance();
+    ADD_FAILURE() << "a speed above time.max_speed was not reported";
+  } catch (const SimulationError& e) {
+    EXPECT_NE(std::string(e.what()).find("unstable at step 1"), std::string::npos) << e.what();
+  }
+}
+
 TEST(ParallelRun, RefusesWhatIsNotDistributedYet) {
   const Communicator world = Communicator::world();
   const auto refused = [&](const io::Config& config, const std::string& key) {

@@ -70,21 +70,36 @@ void DistributedSimulation::advance() {
 }
 
 void DistributedSimulation::check_stability() const {
-  // Each component of the owned nodes (a speed bound per component: the serial check bounds |U|, so it is weaker).
+  // As Simulation's check: every owned node's position and velocity finite and its speed |U| within time.max_speed,
+  // then the fluid velocity and pressure on this process's slab.
   const auto X = op_->positions();
   const auto U = op_->node_velocity();
   const auto offsets = op_->membrane_offsets();
   std::string what;
-  for (std::size_t i = 0; i < X.size() && what.empty(); ++i) {
-    if (std::isfinite(X[i]) && std::isfinite(U[i]) && std::abs(U[i]) <= max_speed_) continue;
+  for (std::size_t i = 0; i + 2 < X.size() && what.empty(); i += 3) {
+    const Vec3 x{X[i], X[i + 1], X[i + 2]}, u{U[i], U[i + 1], U[i + 2]};
+    if (isfinite(x) && isfinite(u) && norm(u) <= max_speed_) continue;
     const auto k = static_cast<std::size_t>(std::upper_bound(offsets.begin(), offsets.end(), i) - offsets.begin()) - 1;
     std::ostringstream s;
     s.precision(10);
     s << "unstable at step " << step_ << ", t = " << time() << ": membrane[" << op_->ownership().owned()[k].id
-      << "] node " << (i - offsets[k]) / 3 << " has position " << X[i] << " m and velocity " << U[i]
-      << " m/s along " << "xyz"[i % 3] << " (bound " << max_speed_ << " m/s)";
+      << "] node " << (i - offsets[k]) / 3 << " "
+      << (!isfinite(x)   ? "position is not finite"
+          : !isfinite(u) ? "velocity is not finite"
+                         : "speed exceeds time.max_speed (runaway)")
+      << " (|u| = " << norm(u) << " m/s, bound " << max_speed_ << " m/s)";
     what = s.str();
   }
+  const FluidState& f = op_->fluid_state();
+  for (int d = 0; d < 3 && what.empty(); ++d)
+    for (double v : f.u[d].values())
+      if (!(std::abs(v) <= max_speed_)) {
+        what = "unstable at step " + std::to_string(step_) + ": fluid velocity u_" + "xyz"[d] +
+               " is not finite or exceeds time.max_speed (runaway)";
+        break;
+      }
+  if (what.empty() && !std::ranges::all_of(f.p.values(), [](double v) { return std::isfinite(v); }))
+    what = "unstable at step " + std::to_string(step_) + ": fluid pressure is not finite";
   const Communicator& comm = fluid_.decomposition().communicator();
   if (comm.sum(what.empty() ? 0.0 : 1.0) > 0)
     throw SimulationError(what.empty() ? "unstable at step " + std::to_string(step_) + " on another process" : what);
