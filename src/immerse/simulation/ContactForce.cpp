@@ -32,6 +32,32 @@ ContactForce::ContactForce(const Grid& grid, const ContactSettings& settings, co
   for (std::size_t m = 0; m + 1 < offsets.size(); ++m) membrane_of_.insert(membrane_of_.end(), offsets[m + 1] - offsets[m], m);
 }
 
+ContactForce::Bounds ContactForce::bounds(std::span<const Vec3> X) {
+  Vec3 lo = X[0], hi = lo;
+  for (const Vec3& x : X)
+    for (int k = 0; k < 3; ++k) lo[k] = std::min(lo[k], x[k]), hi[k] = std::max(hi[k], x[k]);
+  Bounds b;
+  b.centre = 0.5 * (lo + hi);
+  b.half = 0.5 * (hi - lo);
+  for (const Vec3& x : X) b.radius = std::max(b.radius, norm(x - b.centre));
+  return b;
+}
+
+bool ContactForce::boxes_within_range(const Grid& grid, double d, const Bounds& a, const Bounds& b) {
+  bool overlap = norm(minimum_image(grid, a.centre, b.centre)) < a.radius + b.radius + d;
+  for (int k = 0; k < 3 && overlap; ++k) {
+    const double reach = a.half[k] + b.half[k] + d;
+    double gap = a.centre[k] - b.centre[k];
+    if (grid.periodic(k)) {
+      const double L = grid.length(k);
+      if (reach >= 0.5 * L) continue;  // the boxes may meet through either image
+      gap -= L * std::round(gap / L);
+    }
+    overlap = std::abs(gap) < reach;
+  }
+  return overlap;
+}
+
 std::array<long, 3> ContactForce::bin_coords(const Vec3& p) const {
   std::array<long, 3> c{};
   for (int k = 0; k < 3; ++k) {
@@ -47,36 +73,15 @@ void ContactForce::bin(std::span<const Vec3> X) {
   // (c the box centre, s its half-width, the difference wrapped into half a period when s_a + s_b + d is below it),
   // and |c_a - c_b| < R_a + R_b + d by minimum image (R the largest distance of a node from c).
   const std::size_t membranes = offsets_.size() - 1;
-  std::vector<Vec3> centre(membranes), half(membranes);
-  std::vector<double> radius(membranes, 0.0);
-  for (std::size_t m = 0; m < membranes; ++m) {
-    Vec3 lo = X[offsets_[m]], hi = lo;
-    for (std::size_t i = offsets_[m]; i < offsets_[m + 1]; ++i)
-      for (int k = 0; k < 3; ++k) lo[k] = std::min(lo[k], X[i][k]), hi[k] = std::max(hi[k], X[i][k]);
-    centre[m] = 0.5 * (lo + hi);
-    half[m] = 0.5 * (hi - lo);
-    for (std::size_t i = offsets_[m]; i < offsets_[m + 1]; ++i) radius[m] = std::max(radius[m], norm(X[i] - centre[m]));
-  }
-  const double d = settings_.range;
+  std::vector<Bounds> box(membranes);
+  for (std::size_t m = 0; m < membranes; ++m) box[m] = bounds(X.subspan(offsets_[m], offsets_[m + 1] - offsets_[m]));
   touching_.assign(membranes, 0);
   for (std::size_t a = 0; a < membranes; ++a)
-    for (std::size_t b = a + 1; b < membranes; ++b) {
-      bool overlap = norm(minimum_image(grid_, centre[a], centre[b])) < radius[a] + radius[b] + d;
-      for (int k = 0; k < 3 && overlap; ++k) {
-        const double reach = half[a][k] + half[b][k] + d;
-        double gap = centre[a][k] - centre[b][k];
-        if (grid_.periodic(k)) {
-          const double L = grid_.length(k);
-          if (reach >= 0.5 * L) continue;  // the boxes may meet through either image
-          gap -= L * std::round(gap / L);
-        }
-        overlap = std::abs(gap) < reach;
-      }
-      if (overlap) touching_[a] = touching_[b] = 1;
-    }
+    for (std::size_t b = a + 1; b < membranes; ++b)
+      if (boxes_within_range(grid_, settings_.range, box[a], box[b])) touching_[a] = touching_[b] = 1;
   if (std::ranges::find(touching_, char{1}) == touching_.end()) return;  // no node has a neighbour: no bins needed
   // Bins of at least d; fewer (larger) ones where the box holds many more bins than nodes.
-  const long limit = 27 + 8 * static_cast<long>(X.size());
+  const long limit = 27 + 8 * static_cast<long>(search_nodes_ > 0 ? search_nodes_ : X.size());
   for (int k = 0; k < 3; ++k) nb_[k] = std::max(1L, static_cast<long>(std::floor(grid_.length(k) / settings_.range)));
   while (nb_[0] * nb_[1] * nb_[2] > limit) {
     long& largest = *std::max_element(nb_.begin(), nb_.end());

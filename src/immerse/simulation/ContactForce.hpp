@@ -27,7 +27,9 @@
 // then node index): the sums do not depend on the thread count. With no node within d of another membrane or a
 // wall every force is exactly zero, and the run is bitwise that without contact.
 // Verified by tests/test_simulation_contact.cpp (ContactForce.*: gradient, support, third law, walls, neighbour
-// search against brute force; ContactRun.*: two capsules kept apart in shear, an isolated capsule unchanged).
+// search against brute force; ContactRun.*: two capsules kept apart in shear, an isolated capsule unchanged) and
+// ParallelRun.* (bounds(), boxes_within_range() and set_search_nodes() on part of the membranes, in
+// DistributedOperator: the forces of a distributed run equal the one-process run's).
 #include <array>
 #include <cstddef>
 #include <span>
@@ -57,6 +59,21 @@ class ContactForce {
                std::vector<double> moduli);
 
   bool active() const { return settings_.range > 0; }
+  /// Sizes the bins of the neighbour search as for `nodes` nodes instead of the nodes passed to compute() (0: those).
+  /// A process that computes the forces of some membranes from them and their neighbours alone (DistributedOperator)
+  /// passes the node count of all membranes: its bins, and so each node's order of additions, are then those of the
+  /// whole run, and its forces equal the whole run's bitwise.
+  void set_search_nodes(std::size_t nodes) { search_nodes_ = nodes; }
+
+  /// The bounding box of a membrane's nodes X, as the broad phase sees it: centre c, half-widths s and the largest
+  /// distance R of a node from c.
+  struct Bounds {
+    Vec3 centre, half;
+    double radius = 0;
+  };
+  static Bounds bounds(std::span<const Vec3> X);
+  /// The broad phase's test (see bin()): whether two membranes with these bounds may have nodes within d.
+  static bool boxes_within_range(const Grid& grid, double d, const Bounds& a, const Bounds& b);
   /// F = -dE/dX at the concatenated nodes X (F sized like X; overwritten).
   void compute(std::span<const Vec3> X, std::span<Vec3> F);
   /// E (J).
@@ -95,6 +112,7 @@ class ContactForce {
   std::vector<std::size_t> node_bin_, start_, sorted_;  ///< bin of each node; bin b holds sorted_[start_[b] .. start_[b+1])
   std::vector<std::size_t> next_;                       ///< bin() work: next free slot of each bin
   std::vector<char> touching_;                          ///< per membrane: may touch another (bin())
+  std::size_t search_nodes_ = 0;                        ///< set_search_nodes()
 };
 
 }  // namespace immerse

@@ -67,11 +67,6 @@ class Simulation {
   void restore(const io::Checkpoint& ck);
 
  private:
-  void build_membranes();
-  void add_membrane(const io::Config& m, Mesh mesh, std::vector<Vec3> initial, std::vector<Vec3> reference);
-  void pack_membranes(const std::function<bool()>& stop_requested);
-  FluidState initial_fluid_state() const;
-  void check_geometry() const;
   void check_stability(const StepRecord& r) const;
 
   io::Config config_;

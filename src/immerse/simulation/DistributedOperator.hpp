@@ -1,0 +1,122 @@
+#pragma once
+// The coupled fluid-membrane step of ImmersedBoundaryOperator (the algorithm of §3) distributed over MPI processes:
+// the fluid on slabs of z planes (SlabNavierStokesSolver), each membrane on the process owning it (MembraneOwnership:
+// the slab of its centroid). Each process's unknowns are the node positions of the membranes it owns, in ascending
+// global index, so the explicit integrators (ForwardEuler, MidpointRK2), which only combine positions and velocities
+// node by node, run unchanged on every process, each calling the collective methods below in the same sequence.
+//
+//   f(X)      membrane forces of the owned membranes    ElasticMembrane::compute_force (the object of the membrane's
+//                                                       global index; every process holds all of them)
+//             plus the contact forces                    ContactForce on the owned membranes and their neighbours
+//   S(X) f    spread into the slab force field          SlabIBCoupler::spread_force
+//   u^{n+1}   one step on the slabs                     SlabNavierStokesSolver::step
+//   J(X) u    interpolated back to the owned nodes      SlabIBCoupler::interpolate_velocity
+//
+// Contact. A node's contact force sums its neighbours on other membranes within contact.range d. Each evaluation
+// all-gathers the bounding box of every membrane (ContactForce::bounds, from the positions of the evaluation); a
+// membrane's positions go to every other process owning a membrane whose box comes within d of it
+// (ContactForce::boxes_within_range, the serial broad phase, tested with the lower index first as there), in one
+// MPI_Alltoallv. The process then evaluates ContactForce on its own and the received membranes, concatenated in
+// ascending global index, with the bins sized for all the nodes of the run (ContactForce::set_search_nodes): the bins
+// are the serial ones, a bin lists its nodes in ascending global order, and the nodes left out are of membranes that
+// cannot come within d, so every node adds the same terms in the same order as in one process: the contact forces of
+// the owned nodes equal the serial ones bitwise (given the same positions).
+//
+// Migration. commit() stores X^{n+1}, moves the membranes whose centroid changed slab to their new owners
+// (MembraneOwnership::migrate) and interpolates U^{n+1} = J(X^{n+1}) u^{n+1} at the nodes each process then owns
+// (interpolation equals the serial one bitwise, so this is the serial U^{n+1}); size() may change at every commit.
+//
+// Results. Membrane and contact forces and interpolation equal the serial ones bitwise for the same positions;
+// spreading adds in another order (SlabIBCoupler.hpp), so a run differs from the one-process run by round-off, and is
+// bitwise the same in every run with the same number of processes. A variable viscosity (viscosity contrast) and
+// applied nodal forces are not distributed; the implicit schemes, which need the residual's vectors distributed
+// (PETSc), do not run on it. Every method that evaluates or commits is collective; when a membrane fails (a node
+// outside the box, an inverted element) every process throws SimulationError (the owner naming the membrane).
+// No global state.
+// Verified by: the tests ParallelRun.* (tests/test_parallel_run.cpp, 1 to 4 processes: the quick red-cell channel
+// with the midpoint RK2 scheme, with forward Euler, and with contact between cells of different processes, against
+// the one-process Simulation within 1e-10, repeated bitwise, with cells changing owner on 2 and 4 processes).
+#include <span>
+#include <string>
+#include <vector>
+
+#include "immerse/core/Vec3.hpp"
+#include "immerse/coupling/SlabIBCoupler.hpp"
+#include "immerse/fluid/FluidState.hpp"
+#include "immerse/fluid/SlabNavierStokesSolver.hpp"
+#include "immerse/grid/FaceField.hpp"
+#include "immerse/membrane/ElasticMembrane.hpp"
+#include "immerse/parallel/MembraneOwnership.hpp"
+#include "immerse/simulation/ContactForce.hpp"
+#include "immerse/timestep/CoupledOperator.hpp"
+
+namespace immerse {
+
+class DistributedOperator final : public CoupledOperator {
+ public:
+  /// `membranes`: the force objects of all membranes, by global index (kept by pointer); X0 and `reference` their
+  /// initial and reference positions (every process passes the same); `fluid_state` this process's slab state
+  /// (SlabNavierStokesSolver::scatter); the membranes repel each other and the walls by `contact` (off by default).
+  /// `fluid` and `coupler` are kept by reference. Collective.
+  DistributedOperator(SlabNavierStokesSolver& fluid, SlabIBCoupler& coupler,
+                      std::vector<const ElasticMembrane*> membranes, std::span<const std::vector<Vec3>> X0,
+                      std::span<const std::vector<Vec3>> reference, FluidState fluid_state,
+                      const ContactSettings& contact = {});
+  DistributedOperator(const DistributedOperator&) = delete;  // its ownership refers to the fluid's decomposition
+  DistributedOperator& operator=(const DistributedOperator&) = delete;
+
+  std::size_t size() const override { return 3 * X_.size(); }
+  std::span<const double> positions() const override { return flat(X_); }
+  std::span<const double> node_velocity() const override { return flat(U_); }
+  std::vector<std::size_t> membrane_offsets() const override;
+  double length_scale() const override { return fluid_.grid().h(); }
+  void trial_velocity(std::span<const double> Xf, double theta, std::span<const double> Xi, double dt,
+                      std::span<double> U) override;
+  void committed_velocity(std::span<const double> Xi, std::span<double> U) override;
+  /// One interpolation, of the mean field (u^n + u^{n+1}) / 2.
+  void trial_mean_velocity(std::span<const double> Xf, std::span<const double> Xi, double dt,
+                           std::span<double> U) override;
+  bool trial_matches(std::span<const double> X) const override;
+  void commit(std::span<const double> X, double dt) override;
+  std::size_t fluid_solves() const override { return solves_; }
+
+  /// The owned membranes (global index, positions X^n, reference positions).
+  const MembraneOwnership& ownership() const { return ownership_; }
+  /// This process's slab of the committed fluid state.
+  const FluidState& fluid_state() const { return committed_; }
+  /// Membranes moved to another process by the commits so far (the same on every process).
+  int migrations() const { return migrations_; }
+
+ private:
+  static std::span<const double> flat(const std::vector<Vec3>& v) {
+    return {reinterpret_cast<const double*>(v.data()), 3 * v.size()};
+  }
+  /// X_ and offset_ from the ownership's membranes.
+  void refresh();
+  /// F = f(Xf) at the owned nodes: membrane forces, then the contact forces added. Collective.
+  void nodal_forces(std::span<const Vec3> Xf);
+  /// Adds the contact forces of the owned nodes at Xf to F_. Collective.
+  void add_contact_forces(std::span<const Vec3> Xf);
+  /// Forces at Xf, spreading and the fluid step into trial_ (theta = 1 only). Collective.
+  void trial_step(std::span<const double> Xf, double theta, double dt);
+
+  SlabNavierStokesSolver& fluid_;
+  SlabIBCoupler& coupler_;
+  std::vector<const ElasticMembrane*> membranes_;  ///< all, by global index
+  std::vector<double> moduli_;                     ///< K_s of each membrane, by global index (contact)
+  ContactSettings contact_;
+  std::size_t total_nodes_ = 0;  ///< of all membranes
+  MembraneOwnership ownership_;
+  std::vector<std::size_t> offset_;  ///< first node of each owned membrane in X_, then the node count
+  std::vector<Vec3> X_, U_;          ///< committed positions and node velocities of the owned nodes
+  FluidState committed_, trial_;     ///< slab states
+  FaceField force_;                  ///< S(Xf) f(Xf) of the last trial (slab)
+  FaceField mean_;                   ///< (u^n + u^{n+1}) / 2 of trial_mean_velocity (slab)
+  std::vector<Vec3> F_;              ///< nodal forces of the owned nodes
+  std::vector<std::vector<Vec3>> Fm_;  ///< work: one membrane's forces
+  std::vector<double> trial_X_;      ///< the Xf of the last completed trial (empty when none)
+  std::size_t solves_ = 0;
+  int migrations_ = 0;
+};
+
+}  // namespace immerse

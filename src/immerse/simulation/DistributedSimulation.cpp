@@ -1,0 +1,108 @@
+#include "immerse/simulation/DistributedSimulation.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+#include <string>
+
+#include "immerse/core/Error.hpp"
+#include "immerse/coupling/DeltaKernel.hpp"
+#include "immerse/simulation/RunSetup.hpp"
+
+namespace immerse {
+
+namespace {
+
+/// The configuration, refused (InputError) where it asks for what is not distributed yet.
+const io::Config& distributable(const io::Config& config) {
+  const std::string scheme = config.get<std::string>("time.scheme");
+  if (scheme != "euler" && scheme != "rk2")
+    throw InputError("time.scheme = \"" + scheme +
+                     "\": a distributed run takes the explicit schemes \"euler\" and \"rk2\" only (the implicit "
+                     "schemes' vectors are not distributed yet)");
+  for (std::size_t i = 0; i < config.count("membrane"); ++i) {
+    const io::Config& m = config.entry("membrane", i);
+    const std::string name = "membrane[" + std::to_string(i) + "]";
+    if (m.get<double>("viscosity_ratio") != 1.0)
+      throw InputError(name + ".viscosity_ratio = " + m.value_text("viscosity_ratio") +
+                       ": a viscosity contrast (variable viscosity) is not distributed yet (run in one process)");
+    if (m.get<std::string>("volume_correction") != "none")
+      throw InputError(name + ".volume_correction = " + m.value_text("volume_correction") +
+                       ": the volume correction is not distributed yet (run in one process)");
+  }
+  return config;
+}
+
+}  // namespace
+
+DistributedSimulation::DistributedSimulation(const io::Config& config, Communicator comm)
+    : config_(distributable(config)),
+      dt_(config.get<double>("time.dt")),
+      end_time_(config.get<double>("time.end")),
+      max_speed_(config.get<double>("time.max_speed")),
+      grid_(run_grid(config)),
+      fluid_(grid_, run_fluid_params(config), comm),
+      coupler_(fluid_.decomposition(), delta_kernel(config.get<std::string>("coupling.kernel"))),
+      membranes_(build_membrane_set(config, grid_)) {
+  require(std::isfinite(dt_) && dt_ > 0, "time.dt", dt_, "a finite step > 0");
+  std::vector<const ElasticMembrane*> ms;
+  for (const auto& m : membranes_.membranes) ms.push_back(m.get());
+  op_ = std::make_unique<DistributedOperator>(
+      fluid_, coupler_, std::move(ms), membranes_.initial, membranes_.references,
+      fluid_.scatter(run_initial_fluid_state(config_, grid_, fluid_.params())), run_contact_settings(config_));
+  integrator_ = make_integrator(config_.get<std::string>("time.scheme"), run_solver_settings(config_));
+}
+
+bool DistributedSimulation::finished() const { return time() >= end_time_ * (1 - 1e-12); }
+
+void DistributedSimulation::advance() {
+  const double dt = std::min(dt_, end_time_ - time());
+  std::ostringstream where;
+  where.precision(10);
+  where << "step " << step_ + 1 << ", t = " << time() << ": ";
+  try {
+    integrator_->step(*op_, dt);
+  } catch (const SimulationError& e) {
+    throw SimulationError(where.str() + e.what());
+  }
+  ++step_;
+  check_stability();
+}
+
+void DistributedSimulation::check_stability() const {
+  // As Simulation's check: every owned node's position and velocity finite and its speed |U| within time.max_speed,
+  // then the fluid velocity and pressure on this process's slab.
+  const auto X = op_->positions();
+  const auto U = op_->node_velocity();
+  const auto offsets = op_->membrane_offsets();
+  std::string what;
+  for (std::size_t i = 0; i + 2 < X.size() && what.empty(); i += 3) {
+    const Vec3 x{X[i], X[i + 1], X[i + 2]}, u{U[i], U[i + 1], U[i + 2]};
+    if (isfinite(x) && isfinite(u) && norm(u) <= max_speed_) continue;
+    const auto k = static_cast<std::size_t>(std::upper_bound(offsets.begin(), offsets.end(), i) - offsets.begin()) - 1;
+    std::ostringstream s;
+    s.precision(10);
+    s << "unstable at step " << step_ << ", t = " << time() << ": membrane[" << op_->ownership().owned()[k].id
+      << "] node " << (i - offsets[k]) / 3 << " "
+      << (!isfinite(x)   ? "position is not finite"
+          : !isfinite(u) ? "velocity is not finite"
+                         : "speed exceeds time.max_speed (runaway)")
+      << " (|u| = " << norm(u) << " m/s, bound " << max_speed_ << " m/s)";
+    what = s.str();
+  }
+  const FluidState& f = op_->fluid_state();
+  for (int d = 0; d < 3 && what.empty(); ++d)
+    for (double v : f.u[d].values())
+      if (!(std::abs(v) <= max_speed_)) {
+        what = "unstable at step " + std::to_string(step_) + ": fluid velocity u_" + "xyz"[d] +
+               " is not finite or exceeds time.max_speed (runaway)";
+        break;
+      }
+  if (what.empty() && !std::ranges::all_of(f.p.values(), [](double v) { return std::isfinite(v); }))
+    what = "unstable at step " + std::to_string(step_) + ": fluid pressure is not finite";
+  const Communicator& comm = fluid_.decomposition().communicator();
+  if (comm.sum(what.empty() ? 0.0 : 1.0) > 0)
+    throw SimulationError(what.empty() ? "unstable at step " + std::to_string(step_) + " on another process" : what);
+}
+
+}  // namespace immerse

@@ -1,0 +1,234 @@
+// Tests of a whole coupled run distributed over MPI (DistributedSimulation, DistributedOperator), run by ctest through
+// mpiexec with 1, 2, 3 and 4 processes (tests ParallelRun.np1 … np4).
+//
+// The quick red-cell channel (scenarios/rbc_channel_quick.toml: 48 x 96 x 24 cells, walls along x and z, periodic y,
+// 32 biconcave cells of 642 nodes, Yeoh law, body force, contact within one grid spacing) with the explicit midpoint
+// RK2 scheme at dt = kDt, and with forward Euler for a few steps: the positions gathered from the processes equal the
+// one-process Simulation of the same configuration (on rank 0) within 1e-10 relative, and so do the velocity field
+// and its mean along the flow; the distributed run repeated gives the same bits. Along z the 24 cell planes give
+// slabs of 12/12 planes on 2 processes, 8/8/8 on 3 and 6/6/6/6 on 4: the middle layer of cells lies at z = Lz/2, on
+// the slab boundary of 2 and 4 processes, where cells change owner as they move.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <string>
+#include <vector>
+
+#include "MpiEnvironment.hpp"
+#include "immerse/app/Scenario.hpp"
+#include "immerse/core/Error.hpp"
+#include "immerse/parallel/Communicator.hpp"
+#include "immerse/simulation/ContactForce.hpp"
+#include "immerse/simulation/DistributedSimulation.hpp"
+#include "immerse/simulation/RunSchema.hpp"
+#include "immerse/simulation/Simulation.hpp"
+
+using namespace immerse;
+
+namespace {
+
+// A step of the explicit scheme well inside its stability limit on this channel (see docs/parallel.md).
+constexpr double kDt = 2e-5;
+#if defined(__SANITIZE_ADDRESS__)
+// Under the sanitizers (some thirty times slower) the same comparisons over fewer steps; the optimized build takes
+// the 20 steps of the goal.
+constexpr int kRk2Steps = 3;
+constexpr int kEulerSteps = 2;
+constexpr int kContactSteps = 2;
+#else
+constexpr int kRk2Steps = 20;
+constexpr int kEulerSteps = 5;
+constexpr int kContactSteps = 10;
+#endif
+
+io::Config channel(const std::string& scheme, int steps, const std::vector<std::string>& more = {}) {
+  std::vector<std::string> sets{"time.scheme=\"" + scheme + "\"", "time.dt=" + std::to_string(kDt),
+                                "time.end=" + std::to_string(steps * kDt)};
+  sets.insert(sets.end(), more.begin(), more.end());
+  return apply_scenario(
+      run_schema().parse_file(std::string(IMMERSE_SOURCE_DIR) + "/scenarios/rbc_channel_quick.toml", sets));
+}
+
+double seconds_since(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+struct DistributedResult {
+  std::vector<std::vector<Vec3>> positions;
+  FluidState fluid;
+  int migrations = 0;
+  double seconds = 0;
+};
+
+DistributedResult run_distributed(const io::Config& config, int steps) {
+  const auto t0 = std::chrono::steady_clock::now();
+  DistributedSimulation sim(config, Communicator::world());
+  for (int s = 0; s < steps; ++s) sim.advance();
+  EXPECT_EQ(sim.step(), steps);
+  return {sim.gather_positions(), sim.gather_fluid_state(), sim.migrations(), seconds_since(t0)};
+}
+
+double max_abs(const Array3& a) {
+  double m = 0;
+  for (double v : a.values()) m = std::max(m, std::abs(v));
+  return m;
+}
+
+double mean(const Array3& a) {
+  double s = 0;
+  for (double v : a.values()) s += v;
+  return s / static_cast<double>(a.values().size());
+}
+
+// The distributed run against the serial one and itself; prints the differences on rank 0.
+void compare_with_serial(const std::string& scheme, int steps, const std::vector<std::string>& more = {}) {
+  const Communicator comm = Communicator::world();
+  const io::Config config = channel(scheme, steps, more);
+  const DistributedResult a = run_distributed(config, steps);
+  const DistributedResult b = run_distributed(config, steps);
+  // Bitwise repetition, on every process.
+  ASSERT_EQ(a.positions.size(), b.positions.size());
+  for (std::size_t m = 0; m < a.positions.size(); ++m)
+    for (std::size_t i = 0; i < a.positions[m].size(); ++i)
+      for (int k = 0; k < 3; ++k) ASSERT_EQ(a.positions[m][i][k], b.positions[m][i][k]) << "membrane " << m;
+  for (int d = 0; d < 3; ++d) ASSERT_EQ(a.fluid.u[d].values(), b.fluid.u[d].values()) << "u_" << d;
+  EXPECT_EQ(a.migrations, b.migrations);
+  // The middle layer starts on the slab boundary of 2 and 4 processes: some of its cells change owner.
+  if (comm.size() == 2 || comm.size() == 4) {
+    EXPECT_GT(a.migrations, 0);
+  }
+  if (comm.rank() != 0) return;
+
+  const auto t0 = std::chrono::steady_clock::now();
+  Simulation serial(config);
+  const std::vector<std::vector<Vec3>> start = [&] {
+    std::vector<std::vector<Vec3>> X;
+    for (std::size_t m = 0; m < serial.num_membranes(); ++m) X.push_back(serial.op().membrane_positions(m));
+    return X;
+  }();
+  for (int s = 0; s < steps; ++s) serial.advance([](const std::string&) {});
+  const double serial_seconds = seconds_since(t0);
+  ASSERT_EQ(serial.num_membranes(), a.positions.size());
+  EXPECT_NEAR(serial.time(), steps * kDt, 1e-12 * kDt);
+
+  // Positions: relative to the largest coordinate, and the displacements relative to the largest displacement.
+  double x_max = 0, dx = 0, moved = 0, d_moved = 0;
+  for (std::size_t m = 0; m < serial.num_membranes(); ++m) {
+    const auto X = serial.op().membrane_positions(m);
+    ASSERT_EQ(X.size(), a.positions[m].size());
+    for (std::size_t i = 0; i < X.size(); ++i) {
+      x_max = std::max(x_max, norm(X[i]));
+      dx = std::max(dx, norm(a.positions[m][i] - X[i]));
+      moved = std::max(moved, norm(X[i] - start[m][i]));
+      d_moved = std::max(d_moved, norm((a.positions[m][i] - start[m][i]) - (X[i] - start[m][i])));
+    }
+  }
+  // The velocity field and its mean along the flow (y).
+  const FluidState& f = serial.op().fluid_state();
+  double u_max = 0, du = 0;
+  for (int d = 0; d < 3; ++d) {
+    u_max = std::max(u_max, max_abs(f.u[d]));
+    ASSERT_EQ(f.u[d].values().size(), a.fluid.u[d].values().size());
+    for (std::size_t i = 0; i < f.u[d].values().size(); ++i)
+      du = std::max(du, std::abs(a.fluid.u[d].values()[i] - f.u[d].values()[i]));
+  }
+  const double mean_serial = mean(f.u[1]), mean_distributed = mean(a.fluid.u[1]);
+  std::printf(
+      "[ParallelRun] %s%s, %d steps of %g s on %d processes: positions %.2e (relative to the largest "
+      "coordinate), displacements %.2e (relative to the largest, %.3e m), velocity %.2e (relative to the "
+      "largest), mean u_y %.6e m/s vs %.6e m/s (relative difference %.2e); cells that changed owner: %d; "
+      "distributed %.1f s per run, serial %.1f s\n",
+      scheme.c_str(), more.empty() ? "" : (" " + more[0]).c_str(), steps, kDt, comm.size(), dx / x_max,
+      d_moved / moved, moved, du / u_max, mean_distributed, mean_serial, std::abs(mean_distributed - mean_serial) / std::abs(mean_serial), a.migrations, a.seconds,
+      serial_seconds);
+  EXPECT_GT(moved, 0.0);
+  EXPECT_LE(dx / x_max, 1e-10);
+  EXPECT_LE(d_moved / moved, 1e-10);
+  EXPECT_LE(du / u_max, 1e-10);
+  EXPECT_LE(std::abs(mean_distributed - mean_serial), 1e-10 * std::abs(mean_serial));
+  EXPECT_GT(mean_serial, 0.0);  // the body force drives the flow along +y
+}
+
+}  // namespace
+
+TEST(ParallelRun, RedCellChannelRk2EqualsTheOneProcessRun) { compare_with_serial("rk2", kRk2Steps); }
+
+TEST(ParallelRun, RedCellChannelEulerEqualsTheOneProcessRun) { compare_with_serial("euler", kEulerSteps); }
+
+// Contact between the layers of cells: with a range of 1.5 um (3 h) the nodes of the cells of neighbouring layers,
+// owned by different processes on 2, 3 and 4 processes, and those of the outer layers and the walls repel each other
+// from the first step on.
+TEST(ParallelRun, RedCellChannelWithContactAcrossProcessesEqualsTheOneProcessRun) {
+  const std::string range = "contact.range=1.5e-6";
+  const io::Config config = channel("rk2", kContactSteps, {range});
+  const Communicator comm = Communicator::world();
+  if (comm.rank() == 0) {
+    // The pairs of nodes of different membranes within the range at the start, and those whose membranes have
+    // different owners (the slab of the centroid, B cell planes per process).
+    const Simulation start(config);
+    std::vector<std::size_t> offsets{0};
+    std::vector<Vec3> X;
+    std::vector<int> owner;
+    const Grid& g = start.grid();
+    const int block = (g.n(2) + comm.size() - 1) / comm.size();
+    for (std::size_t m = 0; m < start.num_membranes(); ++m) {
+      const auto Xm = start.op().membrane_positions(m);
+      X.insert(X.end(), Xm.begin(), Xm.end());
+      offsets.push_back(X.size());
+      Vec3 c{};
+      for (const Vec3& x : Xm) c = c + x;
+      c = c / double(Xm.size());
+      owner.push_back(std::clamp(int(std::floor((c.z - g.origin().z) / g.h())), 0, g.n(2) - 1) / block);
+    }
+    ContactForce contact(g, {1.5e-6, 1.0, false}, offsets, std::vector<double>(offsets.size() - 1, 1.0));
+    const auto near = contact.neighbours(X);
+    std::size_t pairs = 0, across = 0;
+    for (std::size_t i = 0; i < X.size(); ++i) {
+      const auto a = std::upper_bound(offsets.begin(), offsets.end(), i) - offsets.begin() - 1;
+      for (std::size_t j : near[i]) {
+        const auto b = std::upper_bound(offsets.begin(), offsets.end(), j) - offsets.begin() - 1;
+        ++pairs;
+        if (owner[std::size_t(a)] != owner[std::size_t(b)]) ++across;
+      }
+    }
+    std::printf("[ParallelRun] %s: %zu node pairs of different membranes in range at the start, %zu of membranes of "
+                "different processes\n",
+                range.c_str(), pairs / 2, across / 2);
+    EXPECT_GT(pairs, 0U);
+    if (comm.size() > 1) {
+      EXPECT_GT(across, 0U);
+    }
+  }
+  compare_with_serial("rk2", kContactSteps, {range});
+}
+
+// A bound on the speed below the flow's: every process stops with a SimulationError (the owners naming the node).
+TEST(ParallelRun, AnUnstableRunStopsOnEveryProcess) {
+  DistributedSimulation sim(channel("rk2", 2, {"time.max_speed=1e-5"}), Communicator::world());
+  try {
+    sim.advance();
+    ADD_FAILURE() << "a speed above time.max_speed was not reported";
+  } catch (const SimulationError& e) {
+    EXPECT_NE(std::string(e.what()).find("unstable at step 1"), std::string::npos) << e.what();
+  }
+}
+
+TEST(ParallelRun, RefusesWhatIsNotDistributedYet) {
+  const Communicator world = Communicator::world();
+  const auto refused = [&](const io::Config& config, const std::string& key) {
+    try {
+      DistributedSimulation sim(config, world);
+      ADD_FAILURE() << key << " was not refused";
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find(key), std::string::npos) << e.what();
+      EXPECT_NE(std::string(e.what()).find("not distributed yet"), std::string::npos) << e.what();
+    }
+  };
+  refused(channel("jfnk", 1), "time.scheme");
+  refused(channel("anderson", 1), "time.scheme");
+  refused(channel("rk2", 1, {"membrane[0].viscosity_ratio=5.0"}), "viscosity_ratio");
+  refused(channel("rk2", 1, {"membrane[0].volume_correction=\"normal_shift\""}), "volume_correction");
+}
