@@ -126,6 +126,29 @@ void SlabIBCoupler::count_planes(std::vector<int>& mine, std::vector<int>& their
   }
 }
 
+SlabIBCoupler::Exchange SlabIBCoupler::plan_exchange(bool spreading) {
+  Exchange e;
+  if (spreading)
+    count_planes(e.send_counts, e.recv_counts);
+  else
+    count_planes(e.recv_counts, e.send_counts);
+  e.send_offsets.assign(size_, 0);
+  e.recv_offsets.assign(size_, 0);
+  for (int r = 1; r < size_; ++r) {
+    e.send_offsets[r] = e.send_offsets[r - 1] + e.send_counts[r - 1];
+    e.recv_offsets[r] = e.recv_offsets[r - 1] + e.recv_counts[r - 1];
+  }
+  send_.resize(static_cast<std::size_t>(e.send_offsets[size_ - 1]) + e.send_counts[size_ - 1]);
+  recv_.resize(static_cast<std::size_t>(e.recv_offsets[size_ - 1]) + e.recv_counts[size_ - 1]);
+  return e;
+}
+
+void SlabIBCoupler::exchange(const Exchange& e) {
+  check(MPI_Alltoallv(send_.data(), e.send_counts.data(), e.send_offsets.data(), MPI_DOUBLE, recv_.data(),
+                      e.recv_counts.data(), e.recv_offsets.data(), MPI_DOUBLE, slabs_.communicator().comm()),
+        "MPI_Alltoallv");
+}
+
 void SlabIBCoupler::check_slab(const FaceField& field, const char* what) const {
   for (int d = 0; d < 3; ++d)
     if (field[d].shape() != slabs_.local_shape(velocity_layout(d)))
@@ -167,14 +190,7 @@ void SlabIBCoupler::spread_force(std::span<const Vec3> X, std::span<const Vec3> 
       },
       kernel_);
   // Each plane of the buffers to its holder, in the order (holder, component, plane).
-  std::vector<int> send_counts, send_offsets(size_, 0), recv_counts, recv_offsets(size_, 0);
-  count_planes(send_counts, recv_counts);
-  for (int r = 1; r < size_; ++r) {
-    send_offsets[r] = send_offsets[r - 1] + send_counts[r - 1];
-    recv_offsets[r] = recv_offsets[r - 1] + recv_counts[r - 1];
-  }
-  send_.resize(static_cast<std::size_t>(send_offsets[size_ - 1]) + send_counts[size_ - 1]);
-  recv_.resize(static_cast<std::size_t>(recv_offsets[size_ - 1]) + recv_counts[size_ - 1]);
+  const Exchange planned = plan_exchange(true);
   std::size_t at = 0;
   for (int r = 0; r < size_; ++r)
     for (int d = 0; d < 3; ++d) {
@@ -186,9 +202,7 @@ void SlabIBCoupler::spread_force(std::span<const Vec3> X, std::span<const Vec3> 
           at += n;
         }
     }
-  check(MPI_Alltoallv(send_.data(), send_counts.data(), send_offsets.data(), MPI_DOUBLE, recv_.data(),
-                      recv_counts.data(), recv_offsets.data(), MPI_DOUBLE, slabs_.communicator().comm()),
-        "MPI_Alltoallv");
+  exchange(planned);
   // The held planes: the sum of the received planes, added in the order of the senders' ranks.
   bool shaped = true;
   for (int d = 0; d < 3; ++d) shaped = shaped && f[d].shape() == slabs_.local_shape(velocity_layout(d));
@@ -219,14 +233,7 @@ void SlabIBCoupler::interpolate_velocity(const FaceField& u, std::span<const Vec
   check_nodes_in_domain(grid_, X);
   std::visit([&](const auto& k) { prepare<std::decay_t<decltype(k)>>(X); }, kernel_);
   // The held planes each process's buffers need, to it, in the order (component, plane) of its buffers.
-  std::vector<int> send_counts, send_offsets(size_, 0), recv_counts, recv_offsets(size_, 0);
-  count_planes(recv_counts, send_counts);
-  for (int r = 1; r < size_; ++r) {
-    send_offsets[r] = send_offsets[r - 1] + send_counts[r - 1];
-    recv_offsets[r] = recv_offsets[r - 1] + recv_counts[r - 1];
-  }
-  send_.resize(static_cast<std::size_t>(send_offsets[size_ - 1]) + send_counts[size_ - 1]);
-  recv_.resize(static_cast<std::size_t>(recv_offsets[size_ - 1]) + recv_counts[size_ - 1]);
+  const Exchange planned = plan_exchange(false);
   const int offset = slabs_.offset();
   std::size_t at = 0;
   for (int r = 0; r < size_; ++r)
@@ -240,11 +247,9 @@ void SlabIBCoupler::interpolate_velocity(const FaceField& u, std::span<const Vec
         at += n;
       }
     }
-  check(MPI_Alltoallv(send_.data(), send_counts.data(), send_offsets.data(), MPI_DOUBLE, recv_.data(),
-                      recv_counts.data(), recv_offsets.data(), MPI_DOUBLE, slabs_.communicator().comm()),
-        "MPI_Alltoallv");
+  exchange(planned);
   for (int r = 0; r < size_; ++r) {  // the planes from holder r sit at recv_offsets[r], in (component, plane) order
-    at = static_cast<std::size_t>(recv_offsets[r]);
+    at = static_cast<std::size_t>(planned.recv_offsets[r]);
     for (int d = 0; d < 3; ++d) {
       const std::size_t n = plane_size(buffer_[d]);
       for (int q = range_[d].begin; q < range_[d].end; ++q) {

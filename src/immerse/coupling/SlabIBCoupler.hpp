@@ -90,6 +90,14 @@ class SlabIBCoupler {
   /// Per rank r, the doubles of this process's buffer planes held by r (mine[r]) and of r's buffer planes held by
   /// this process (theirs[r]): what spreading sends to and receives from r (interpolation: the reverse).
   void count_planes(std::vector<int>& mine, std::vector<int>& theirs) const;
+  /// The counts and offsets of one MPI_Alltoallv of buffer planes, send_ and recv_ sized for it.
+  struct Exchange {
+    std::vector<int> send_counts, send_offsets, recv_counts, recv_offsets;
+  };
+  /// Spreading sends this process's buffer planes to their holders; interpolation (spreading = false) the reverse.
+  Exchange plan_exchange(bool spreading);
+  /// send_ to recv_ as planned (collective).
+  void exchange(const Exchange& e);
   void check_slab(const FaceField& field, const char* what) const;
 
   const SlabDecomposition& slabs_;
