@@ -201,6 +201,33 @@ TEST(CellKinds, TheChannelCopiesTheCellToItsThirtyTwoPlaces) {
       << error_of(text, {"membrane[0].center=[1e-6,1e-6,1e-6]"});
 }
 
+// scenario.copies = [2, 2, 2] in a box twice as long along each axis: the 256-cell channel, each sub-box holding the
+// 32 centres of the one-box channel shifted by its corner.
+TEST(CellKinds, CopiesRepeatTheArrangementInSubBoxes) {
+  std::string text = kCell;
+  text.replace(text.find("kind = \"rbc_stretch\""), 20, "kind = \"rbc_channel\"");
+  text.replace(text.find("y = \"wall\""), 10, "y = \"periodic\"");
+  const io::Config one = resolve(text, {"domain.Lx=2.4e-5", "domain.Ly=4.8e-5", "domain.Lz=1.2e-5"});
+  const io::Config c =
+      resolve(text, {"domain.Lx=4.8e-5", "domain.Ly=9.6e-5", "domain.Lz=2.4e-5", "scenario.copies=[2, 2, 2]"});
+  ASSERT_EQ(c.count("membrane"), 256u);
+  const auto base = channel_cell_centres(one);
+  for (int cz = 0; cz < 2; ++cz)
+    for (int cy = 0; cy < 2; ++cy)
+      for (int cx = 0; cx < 2; ++cx)
+        for (std::size_t i = 0; i < 32; ++i) {
+          const std::size_t k = 32 * (cx + 2 * (cy + 2 * cz)) + i;
+          const Vec3 p = c.get<Vec3>("membrane[" + std::to_string(k) + "].center");
+          EXPECT_NEAR(p.x, base[i].x + cx * 2.4e-5, 1e-18) << k;
+          EXPECT_NEAR(p.y, base[i].y + cy * 4.8e-5, 1e-18) << k;
+          EXPECT_NEAR(p.z, base[i].z + cz * 1.2e-5, 1e-18) << k;
+        }
+  EXPECT_NE(c.derivation("membrane[255].center").find("2 x 2 x 2 sub-boxes of scenario.copies"), std::string::npos);
+  for (const char* bad : {"scenario.copies=[2, 2]", "scenario.copies=[1.5, 1, 1]"})
+    EXPECT_NE(error_of(text, {bad}).find("scenario.copies = "), std::string::npos) << bad << ": " << error_of(text, {bad});
+  EXPECT_NE(error_of(text, {"scenario.copies=[0, 1, 1]"}).find("scenario.copies"), std::string::npos);
+}
+
 TEST(CustomKind, AMembraneWithoutACentreSitsAtTheBoxCentre) {
   const char* text = R"(
 [domain]

@@ -29,15 +29,41 @@ bool continues_in_place(const RunOptions& options) {
 // "KEY = VALUE (how)" for every key a scenario kind derived, the membranes' keys as membrane[i].KEY.
 std::vector<std::string> derived_values(const io::Config& config) {
   std::vector<std::string> lines;
-  const auto add = [&](const io::Config& c, const std::string& prefix) {
-    for (const auto& k : c.schema().keys())
-      if (const std::string how = c.derivation(k.key); !how.empty())
-        lines.push_back(prefix + k.key + " = " + c.value_text(k.key) + " (" + how + ")");
+  const auto line = [](const std::string& name, const std::string& value, const std::string& how) {
+    return name + " = " + value + " (" + how + ")";
   };
-  add(config, "");
-  for (const auto& t : config.schema().table_arrays())
-    for (std::size_t i = 0; i < config.count(t.name); ++i)
-      add(config.entry(t.name, i), t.name + "[" + std::to_string(i) + "].");
+  for (const auto& k : config.schema().keys())
+    if (const std::string how = config.derivation(k.key); !how.empty())
+      lines.push_back(line(k.key, config.value_text(k.key), how));
+  // Entries of a table array derived alike (the cells of a channel) print as one line per key over a run of indices:
+  // t[a..b].key = value when every value is the same, else the count of values (they are in config.resolved.toml).
+  for (const auto& t : config.schema().table_arrays()) {
+    const std::size_t n = config.count(t.name);
+    if (n == 0) continue;
+    for (const auto& k : config.entry(t.name, 0).schema().keys()) {
+      const auto name = [&](std::size_t i) { return t.name + "[" + std::to_string(i) + "]"; };
+      for (std::size_t a = 0; a < n;) {
+        const io::Config& first = config.entry(t.name, a);
+        const std::string how = first.derivation(k.key);
+        std::size_t b = a + 1;
+        bool same = true;
+        while (b < n && !how.empty() && config.entry(t.name, b).derivation(k.key) == how) {
+          same = same && config.entry(t.name, b).value_text(k.key) == first.value_text(k.key);
+          ++b;
+        }
+        if (how.empty()) {
+        } else if (b - a < 3) {
+          for (std::size_t i = a; i < b; ++i)
+            lines.push_back(line(name(i) + "." + k.key, config.entry(t.name, i).value_text(k.key), how));
+        } else {
+          const std::string range = t.name + "[" + std::to_string(a) + ".." + std::to_string(b - 1) + "]." + k.key;
+          lines.push_back(same ? line(range, first.value_text(k.key), how)
+                               : range + ": " + std::to_string(b - a) + " values, in config.resolved.toml (" + how + ")");
+        }
+        a = b;
+      }
+    }
+  }
   return lines;
 }
 

@@ -42,19 +42,36 @@ double shear_rate(const io::Config& c) {
   return std::abs(hi.x - lo.x) / c.get<double>("domain.Lz");
 }
 
+std::array<int, 3> channel_copies(const io::Config& c) {
+  const auto v = c.get<std::vector<double>>("scenario.copies");
+  std::array<int, 3> n{};
+  const bool whole = v.size() == 3 && std::ranges::all_of(v, [](double x) { return x >= 1 && x <= 1e4 && x == std::floor(x); });
+  if (!whole)
+    throw InputError("scenario.copies = " + c.value_text("scenario.copies") +
+                     ": must be three whole numbers >= 1 (copies along x, y and z), e.g. [2, 2, 2]");
+  for (int a = 0; a < 3; ++a) n[a] = static_cast<int>(v[a]);
+  return n;
+}
+
 std::vector<Vec3> channel_cell_centres(const io::Config& c) {
   const Vec3 o = c.get<Vec3>("domain.origin");
-  const double Lx = c.get<double>("domain.Lx"), Ly = c.get<double>("domain.Ly"), Lz = c.get<double>("domain.Lz");
-  std::vector<Vec3> centres;
+  const auto n = channel_copies(c);
+  const double Lx = c.get<double>("domain.Lx") / n[0], Ly = c.get<double>("domain.Ly") / n[1],
+               Lz = c.get<double>("domain.Lz") / n[2];
+  std::vector<Vec3> box;  // the 32 centres in one sub-box
   for (int k = 0; k < 5; ++k)
-    for (double x : {0.25, 0.75}) centres.push_back({x * Lx, (k + 0.25) * Ly / 5, 0.18 * Lz});
+    for (double x : {0.25, 0.75}) box.push_back({x * Lx, (k + 0.25) * Ly / 5, 0.18 * Lz});
   for (int k = 0; k < 4; ++k) {
-    for (double x : {0.2, 0.8}) centres.push_back({x * Lx, (k + 0.125) * Ly / 4, 0.5 * Lz});
-    centres.push_back({0.5 * Lx, (k + 0.625) * Ly / 4, 0.5 * Lz});
+    for (double x : {0.2, 0.8}) box.push_back({x * Lx, (k + 0.125) * Ly / 4, 0.5 * Lz});
+    box.push_back({0.5 * Lx, (k + 0.625) * Ly / 4, 0.5 * Lz});
   }
   for (int k = 0; k < 5; ++k)
-    for (double x : {0.25, 0.75}) centres.push_back({x * Lx, (k + 0.75) * Ly / 5, 0.82 * Lz});
-  for (auto& p : centres) p += o;
+    for (double x : {0.25, 0.75}) box.push_back({x * Lx, (k + 0.75) * Ly / 5, 0.82 * Lz});
+  std::vector<Vec3> centres;
+  for (int cz = 0; cz < n[2]; ++cz)
+    for (int cy = 0; cy < n[1]; ++cy)
+      for (int cx = 0; cx < n[0]; ++cx)
+        for (const Vec3& p : box) centres.push_back(o + p + Vec3{cx * Lx, cy * Ly, cz * Lz});
   return centres;
 }
 
@@ -181,7 +198,7 @@ io::Config derive_shear(const io::Config& config, const std::string& kind) {
 }
 
 // rbc_stretch, rbc_channel: the biconcave cell with the Yeoh law, C10 = mu0/2, C30 = mu0/30; the channel copies the
-// cell to the 32 positions of channel_cell_centres.
+// cell to the 32 positions of channel_cell_centres in each of the scenario.copies sub-boxes.
 io::Config derive_cells(const io::Config& config, const std::string& kind) {
   if (config.count("membrane") != 1)
     throw InputError("scenario.kind = \"" + kind + "\": needs exactly one [[membrane]] (" +
@@ -198,7 +215,12 @@ io::Config derive_cells(const io::Config& config, const std::string& kind) {
     require(config.get<std::string>(std::string("boundary.") + axis) == bc, std::string("boundary.") + axis,
             std::string("\"") + bc + "\" for scenario.kind = \"rbc_channel\" (flow along the periodic y axis)");
   const auto centres = channel_cell_centres(config);
-  const std::string arrangement = "the channel's arrangement of 32 cells in the domain";
+  const auto copies = channel_copies(config);
+  const std::string arrangement =
+      copies == std::array<int, 3>{1, 1, 1}
+          ? std::string("the channel's arrangement of 32 cells in the domain")
+          : "the channel's arrangement of 32 cells in each of the " + std::to_string(copies[0]) + " x " +
+                std::to_string(copies[1]) + " x " + std::to_string(copies[2]) + " sub-boxes of scenario.copies";
   d.fix("membrane[0].center", vec(centres[0]), arrangement, "; for other positions use scenario.kind = \"custom\"");
   io::Config derived = d.take();
   const io::Config cell = derived.entry("membrane", 0);

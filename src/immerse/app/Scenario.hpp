@@ -16,7 +16,10 @@
 // gradient). The cells lie flat (disc in x-y) in three layers at z = 0.18 Lz, Lz/2, 0.82 Lz: the outer layers have
 // two columns at x = Lx/4, 3Lx/4 of five cells each, the middle layer three staggered columns at x = 0.2 Lx, Lx/2,
 // 0.8 Lx of four (10 + 12 + 10). In the paper's 24 x 48 x 12 um duct neighbouring cells are at least 1.2 um apart
-// and 0.88 um from the walls; Simulation checks the clearances of any other box.
+// and 0.88 um from the walls; Simulation checks the clearances of any other box. scenario.copies = [cx, cy, cz] repeats
+// the arrangement in cx x cy x cz sub-boxes of size (Lx/cx, Ly/cy, Lz/cz): [2, 2, 2] in a 48 x 96 x 24 um duct is
+// the 256-cell channel, twice §4.4 along each axis.
+#include <array>
 #include <vector>
 
 #include "immerse/core/Vec3.hpp"
@@ -30,7 +33,11 @@ namespace immerse {
 io::Config apply_scenario(const io::Config& config);
 
 
-/// rbc_channel: the centres of the 32 cells (see above).
+/// rbc_channel: the copies of the 32-cell arrangement along x, y and z (scenario.copies; InputError unless three whole
+/// numbers >= 1).
+std::array<int, 3> channel_copies(const io::Config& config);
+/// rbc_channel: the centres of the 32 cells (see above) in each sub-box of size (Lx/cx, Ly/cy, Lz/cz), sub-box by
+/// sub-box with x fastest.
 std::vector<Vec3> channel_cell_centres(const io::Config& config);
 
 /// The shear rate k of a shear scenario or of a plane Couette flow between walls z = const moving along x (0 when

@@ -86,6 +86,9 @@ ConfigSchema run_schema() {
   s.add_double("scenario.theta0", 0.0, Range::closed(-3.2, 3.2), "oblate_shear: initial inclination (rad)");
   s.add_double("scenario.mu0", 7.3e-6, Range::positive(),
                "rbc_stretch, rbc_channel: in-plane shear modulus mu0 (N/m); Yeoh law with C10 = mu0/2, C30 = mu0/30 (§4.3)");
+  s.add_double_list("scenario.copies", {1, 1, 1}, Range::at_least(1),
+                    "rbc_channel: copies of the 32-cell arrangement along x, y and z (three whole numbers); the box "
+                    "holds cx x cy x cz copies of the arrangement, each in a sub-box of size (Lx/cx, Ly/cy, Lz/cz)");
   s.add_double_list("scenario.forces_pN", {0, 20, 40, 60, 80, 100, 120, 140, 160, 180, 200}, Range::non_negative(),
                     "rbc_stretch: the stretching forces of the sweep (pN), each run to steady state");
   s.add_double("scenario.patch_um", 2.0, Range::positive(),
