@@ -7,7 +7,8 @@
 // one-process Simulation of the same configuration (on rank 0) within 1e-10 relative, and so do the velocity field
 // and its mean along the flow; the distributed run repeated gives the same bits. Along z the 24 cell planes give
 // slabs of 12/12 planes on 2 processes, 8/8/8 on 3 and 6/6/6/6 on 4: the middle layer of cells lies at z = Lz/2, on
-// the slab boundary of 2 and 4 processes, where cells change owner as they move.
+// the slab boundary of 2 and 4 processes, where cells change owner as they move. The same channel with λ = 5 cells
+// and the volume correction (normal shift) checks the distributed viscosity contrast and the shift of the owned cells.
 #include <gtest/gtest.h>
 
 #include <algorithm>
