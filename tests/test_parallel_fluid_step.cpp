@@ -223,18 +223,6 @@ TEST(ParallelFluidStep, FiveStepsOnSlabsEqualTheSerialStepsAndRepeatBitwise) {
   }
 }
 
-TEST(ParallelFluidStep, RefusesAVariableViscosity) {
-  FluidParams params;
-  params.variable_viscosity = true;
-  params.implicit_ratio = 2.0;
-  try {
-    SlabNavierStokesSolver refused(grid_with({P, P, W}), params, Communicator::world());
-    ADD_FAILURE() << "a slab solver with a variable viscosity was made";
-  } catch (const std::invalid_argument& e) {
-    EXPECT_NE(std::string(e.what()).find("variable viscosity is not distributed yet"), std::string::npos) << e.what();
-  }
-}
-
 // 3 processes for 4 cells between z walls: blocks of 2 leave the last process no cell; 2 processes for 3 cells
 // leave it one, too few for a plane of u_z. One process is always accepted.
 TEST(ParallelFluidStep, RefusesACutThatLeavesAProcessWithoutPlanes) {

@@ -8,6 +8,7 @@
 #include "immerse/core/Error.hpp"
 #include "immerse/fluid/MacStencil_K.hpp"
 #include "immerse/fluid/NavierStokesSolver.hpp"
+#include "immerse/fluid/ViscousStress_K.hpp"
 
 namespace immerse {
 
@@ -35,13 +36,15 @@ SlabNavierStokesSolver::SlabNavierStokesSolver(const Grid& grid, const FluidPara
       slabs_(grid, comm),
       halo_(slabs_, params.wall_lower[2], params.wall_upper[2]),
       geom_(grid, params),
-      local_(geom_) {
+      local_(geom_),
+      local0_(grid),
+      halo0_(slabs_, Vec3{}, Vec3{}),
+      mu_implicit_(params.variable_viscosity ? params.implicit_ratio * params.mu : params.mu) {
   params_.validate(grid_);
-  if (params_.variable_viscosity)
-    throw std::invalid_argument(
-        "SlabNavierStokesSolver: a variable viscosity is not distributed yet (use NavierStokesSolver)");
-  local_.n[2] = slabs_.local_shape(Layout::Pressure)[2];
-  local_.periodic[2] = true;
+  for (MacStencilGrid* g : {&local_, &local0_}) {
+    g->n[2] = slabs_.local_shape(Layout::Pressure)[2];
+    g->periodic[2] = true;
+  }
   const int off = slabs_.offset();
   for (int d = 0; d < 3; ++d) {
     const PlaneRange own = slabs_.owned(velocity_layout(d));
@@ -64,6 +67,11 @@ SlabNavierStokesSolver::SlabNavierStokesSolver(const Grid& grid, const FluidPara
   for (int d = 0; d < 3; ++d) ustar_[d] = slabs_.make(velocity_layout(d));
   div_ = slabs_.make(Layout::Pressure);
   phi_ = slabs_.make(Layout::Pressure);
+  if (params_.variable_viscosity)
+    for (int d = 0; d < 3; ++d) {
+      explicit_[d] = slabs_.make(velocity_layout(d));
+      utilde_[d] = slabs_.make(velocity_layout(d));
+    }
 }
 
 bool SlabNavierStokesSolver::is_slab(const FaceField& f) const {
@@ -103,9 +111,13 @@ void SlabNavierStokesSolver::apply_wall_values(FaceField& u) const {
   }
 }
 
-void SlabNavierStokesSolver::step(const FluidState& in, const FaceField& force, double dt, FluidState& out) {
+void SlabNavierStokesSolver::step(const FluidState& in, const FaceField& force, double dt, FluidState& out,
+                                  const Array3* chi) {
   check(in, dt, force);
   if (&in == &out) throw std::invalid_argument("SlabNavierStokesSolver::step: `in` and `out` must be different states");
+  const bool variable = params_.variable_viscosity;
+  if (variable && chi && chi->shape() != slabs_.local_shape(Layout::Pressure))
+    throw std::invalid_argument("SlabNavierStokesSolver::step: the viscosity field is not a slab array of the cells");
   ensure_slabs(out);
   out.adv_of = 0;
   const int off = slabs_.offset();
@@ -122,12 +134,27 @@ void SlabNavierStokesSolver::step(const FluidState& in, const FaceField& force, 
   }
 
   // (9): the right-hand side on the owned faces and (u·∇_h u)^n into the new state, then the three solves.
-  const double rho = params_.rho, mu = params_.mu;
+  // With a variable viscosity as NavierStokesSolver's prepared step: the explicit terms first, then the right-hand
+  // side under the force and the stress term.
+  const double rho = params_.rho, mu = mu_implicit_;
   const double c = mu * dt / (2.0 * rho);
   const double dt_rho = dt / rho;
+  if (variable) {
+    for (int d = 0; d < 3; ++d)
+      build<false>(local_, region_[d], d, in, *p, nullptr, rhs_coefficients(params_, in, dt, d), out.adv[d],
+                   explicit_[d]);
+    prepare_variable(in, dt);
+  }
   for (int d = 0; d < 3; ++d) {
-    build<true>(local_, region_[d], d, in, *p, &force[d], rhs_coefficients(params_, in, dt, d), out.adv[d],
-                ustar_[d]);
+    const RhsCoefficients coefficients = rhs_coefficients(params_, in, dt, d);
+    if (variable) {
+      for_each_row(local_, region_[d].all, [&](int j, int k, int i0, int i1) {
+        rhs_row<false>(in.u[d], explicit_[d], force[d], out.adv[d], coefficients, ustar_[d], out.adv[d], j, k, i0, i1);
+      });
+      if (chi) add_variable_stress(*chi, dt, d);
+    } else {
+      build<true>(local_, region_[d], d, in, *p, &force[d], coefficients, out.adv[d], ustar_[d]);
+    }
     solvers_[d]->solve(ustar_[d], slabs_.owned(velocity_layout(d)).begin - off, 1.0, -c);
   }
   apply_wall_values(ustar_);
@@ -157,6 +184,8 @@ void SlabNavierStokesSolver::step(const FluidState& in, const FaceField& force, 
     for (std::size_t q = o; q < o + n; ++q) out.p[q] = (*p)[q] + phi_[q] - half_mu * div_[q];
   }
   out.p_prev.values() = in.p.values();  // with its ghosts
+  if (variable)
+    for (int d = 0; d < 3; ++d) out.u_prev[d] = in.u[d];  // with its ghosts
   apply_wall_values(out.u);
   for (int d = 0; d < 3; ++d) halo_.exchange(out.u[d], velocity_layout(d));
   halo_.exchange(out.p, Layout::Pressure);
@@ -167,8 +196,70 @@ void SlabNavierStokesSolver::step(const FluidState& in, const FaceField& force, 
   out.time = in.time + dt;
 }
 
+void SlabNavierStokesSolver::prepare_variable(const FluidState& in, double dt) {
+  const bool extrapolate = !first_step(in) && is_slab(in.u_prev);
+  const double half_r = extrapolate ? 0.5 * dt / in.dt_prev : 0.0;
+  const double dmu = mu_implicit_ - params_.mu;
+  for (int d = 0; d < 3; ++d) {
+    const Layout layout = velocity_layout(d);
+    const std::size_t n = in.u[d].size();
+    const double* const u = in.u[d].data();
+    const double* const up = extrapolate ? in.u_prev[d].data() : u;
+    double* const ut = utilde_[d].data();
+    if (dmu != 0) {
+      // (μ_p − μ) ∇_h²(u^n/2 − ũ) with homogeneous walls, from u^n/2 − ũ held in utilde_ meanwhile.
+      for (std::size_t q = 0; q < n; ++q) ut[q] = 0.5 * u[q] - (u[q] + half_r * (u[q] - up[q]));
+      halo0_.exchange(utilde_[d], layout);
+      const IndexBox& box = region_[d].all;
+      Array3& e = explicit_[d];
+      for (int k = box.begin[2]; k < box.end[2]; ++k)
+        for (int j = box.begin[1]; j < box.end[1]; ++j)
+          for (int i = box.begin[0]; i < box.end[0]; ++i)
+            e(i, j, k) += dmu * mac::laplacian_face(utilde_[d], local0_, d, mac::Index{i, j, k});
+    }
+    for (std::size_t q = 0; q < n; ++q) ut[q] = u[q] + half_r * (u[q] - up[q]);
+    halo_.exchange(utilde_[d], layout);  // beyond a z wall the ghost 2 u_w − ũ_0 (or the wall face) of the kernel
+  }
+}
+
+void SlabNavierStokesSolver::add_variable_stress(const Array3& chi, double dt, int d) {
+  // The faces whose stencil reads a non-zero χ (cells within one index along each axis), as
+  // NavierStokesSolver::variable_stress_box on the slab's planes (ghosts included); zero χ adds nothing elsewhere.
+  std::array<int, 3> lo{chi.nx(), chi.ny(), chi.nz()}, hi{-1, -1, -1};
+  for (int k = 0; k < chi.nz(); ++k)
+    for (int j = 0; j < chi.ny(); ++j)
+      for (int i = 0; i < chi.nx(); ++i)
+        if (chi(i, j, k) != 0.0) {
+          const std::array<int, 3> q{i, j, k};
+          for (int a = 0; a < 3; ++a) {
+            lo[a] = std::min(lo[a], q[a]);
+            hi[a] = std::max(hi[a], q[a]);
+          }
+        }
+  if (hi[0] < 0) return;
+  const IndexBox& own = region_[d].all;
+  IndexBox box{};
+  for (int a = 0; a < 3; ++a) {
+    if (a < 2 && local_.periodic[a] && (lo[a] < 1 || hi[a] > local_.n[a] - 2)) {
+      box.begin[a] = own.begin[a];
+      box.end[a] = own.end[a];
+    } else {
+      box.begin[a] = std::max(lo[a] - 1, own.begin[a]);
+      box.end[a] = std::min(hi[a] + 2, own.end[a]);
+    }
+  }
+  const double c = dt / params_.rho * params_.mu;
+  Array3& rhs = ustar_[d];
+  for (int k = box.begin[2]; k < box.end[2]; ++k)
+    for (int j = box.begin[1]; j < box.end[1]; ++j)
+      for (int i = box.begin[0]; i < box.end[0]; ++i)
+        rhs(i, j, k) += c * mac::stress_divergence(utilde_, chi, local_, d, mac::Index{i, j, k});
+}
+
 void SlabNavierStokesSolver::exchange_ghosts(FluidState& s) const {
   for (int d = 0; d < 3; ++d) halo_.exchange(s.u[d], velocity_layout(d));
+  if (is_slab(s.u_prev))
+    for (int d = 0; d < 3; ++d) halo_.exchange(s.u_prev[d], velocity_layout(d));
   halo_.exchange(s.p, Layout::Pressure);
   halo_.exchange(s.p_prev, Layout::Pressure);
 }
@@ -179,6 +270,10 @@ FluidState SlabNavierStokesSolver::scatter(const FluidState& global) const {
   for (int d = 0; d < 3; ++d) {
     slabs_.scatter(global.u[d], velocity_layout(d), s.u[d]);
     if (global.adv[d].shape() == grid_.face_shape(d)) slabs_.scatter(global.adv[d], velocity_layout(d), s.adv[d]);
+    if (params_.variable_viscosity && global.u_prev[d].shape() == grid_.face_shape(d)) {
+      s.u_prev[d] = slabs_.make(velocity_layout(d));
+      slabs_.scatter(global.u_prev[d], velocity_layout(d), s.u_prev[d]);
+    }
   }
   slabs_.scatter(global.p, Layout::Pressure, s.p);
   if (global.p_prev.shape() == grid_.cell_shape()) slabs_.scatter(global.p_prev, Layout::Pressure, s.p_prev);
@@ -200,6 +295,7 @@ FluidState SlabNavierStokesSolver::gather(const FluidState& local) const {
   FluidState s;
   s.u = gather(local.u);
   s.adv = gather(local.adv);
+  if (is_slab(local.u_prev)) s.u_prev = gather(local.u_prev);
   s.p = slabs_.gather(local.p, Layout::Pressure);
   s.p_prev = slabs_.gather(local.p_prev, Layout::Pressure);
   s.dt_prev = local.dt_prev;

@@ -32,7 +32,7 @@ DistributedOperator::DistributedOperator(SlabNavierStokesSolver& fluid, SlabIBCo
                                          std::vector<const ElasticMembrane*> membranes,
                                          std::span<const std::vector<Vec3>> X0,
                                          std::span<const std::vector<Vec3>> reference, FluidState fluid_state,
-                                         const ContactSettings& contact)
+                                         const ContactSettings& contact, std::vector<double> viscosity_ratio)
     : fluid_(fluid),
       coupler_(coupler),
       membranes_(std::move(membranes)),
@@ -49,9 +49,29 @@ DistributedOperator::DistributedOperator(SlabNavierStokesSolver& fluid, SlabIBCo
   }
   if (contact_.range > 0)  // refuses a range of half a periodic length or more (InputError), on every process alike
     [[maybe_unused]] const ContactForce validated(fluid_.grid(), contact_, {0, total_nodes_}, {0.0});
+  if (std::ranges::any_of(viscosity_ratio, [](double r) { return r != 1.0; })) {
+    if (viscosity_ratio.size() != membranes_.size())
+      throw std::logic_error("DistributedOperator: one viscosity ratio per membrane");
+    if (!fluid_.params().variable_viscosity)
+      throw std::logic_error("DistributedOperator: a viscosity contrast needs a fluid solver with variable viscosity");
+    indicator_ = std::make_unique<SlabViscosityIndicator>(coupler_, std::move(viscosity_ratio));
+  }
   refresh();
   U_.resize(X_.size());
   coupler_.interpolate_velocity(committed_.u, X_, U_);
+}
+
+void DistributedOperator::update_indicator(std::span<const Vec3> Xf) {
+  const auto& owned = ownership_.owned();
+  Xmid_.resize(owned.size());
+  std::vector<OwnedIndicatorSurface> surfaces;
+  for (std::size_t k = 0; k < owned.size(); ++k) {
+    const std::size_t n = offset_[k + 1] - offset_[k];
+    Xmid_[k].resize(n);
+    for (std::size_t i = 0; i < n; ++i) Xmid_[k][i] = 0.5 * (X_[offset_[k] + i] + Xf[offset_[k] + i]);
+    surfaces.push_back({owned[k].id, &membranes_[static_cast<std::size_t>(owned[k].id)]->elements(), &Xmid_[k]});
+  }
+  indicator_->compute(surfaces, chi_);
 }
 
 void DistributedOperator::refresh() {
@@ -174,7 +194,8 @@ void DistributedOperator::trial_step(std::span<const double> Xf, double theta, d
   trial_X_.clear();
   nodal_forces(nodes(Xf));
   coupler_.spread_force(nodes(Xf), F_, force_);
-  fluid_.step(committed_, force_, dt, trial_);
+  if (indicator_) update_indicator(nodes(Xf));
+  fluid_.step(committed_, force_, dt, trial_, indicator_ ? &chi_ : nullptr);
   ++solves_;
 }
 
@@ -202,6 +223,16 @@ void DistributedOperator::trial_mean_velocity(std::span<const double> Xf, std::s
 
 void DistributedOperator::committed_velocity(std::span<const double> Xi, std::span<double> U) {
   coupler_.interpolate_velocity(committed_.u, nodes(Xi), nodes(U));
+}
+
+void DistributedOperator::correct_positions(std::span<const Vec3> X) {
+  if (X.size() != X_.size()) throw std::logic_error("DistributedOperator::correct_positions: one position per node");
+  ownership_.set_owned_positions(X);
+  migrations_ += ownership_.migrate();
+  refresh();
+  U_.resize(X_.size());
+  coupler_.interpolate_velocity(committed_.u, X_, U_);
+  trial_X_.clear();
 }
 
 bool DistributedOperator::trial_matches(std::span<const double> X) const {

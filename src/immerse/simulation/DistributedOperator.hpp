@@ -9,6 +9,8 @@
 //                                                       global index; every process holds all of them)
 //             plus the contact forces                    ContactForce on the owned membranes and their neighbours
 //   S(X) f    spread into the slab force field          SlabIBCoupler::spread_force
+//   χ(X̄)      interior indicator, viscosity contrast     SlabViscosityIndicator::compute (X̄ = (X^n + Xf)/2, the
+//                                                       owned membranes' midpoints, as ImmersedBoundaryOperator)
 //   u^{n+1}   one step on the slabs                     SlabNavierStokesSolver::step
 //   J(X) u    interpolated back to the owned nodes      SlabIBCoupler::interpolate_velocity
 //
@@ -28,20 +30,24 @@
 //
 // Results. Membrane and contact forces and interpolation equal the serial ones bitwise for the same positions;
 // spreading adds in another order (SlabIBCoupler.hpp), so a run differs from the one-process run by round-off, and is
-// bitwise the same in every run with the same number of processes. A variable viscosity (viscosity contrast) and
-// applied nodal forces are not distributed; the implicit schemes, which need the residual's vectors distributed
-// (PETSc), do not run on it. Every method that evaluates or commits is collective; when a membrane fails (a node
+// bitwise the same in every run with the same number of processes. Applied nodal forces are not distributed; the
+// implicit schemes, which need the residual's vectors distributed (PETSc), do not run on it. correct_positions()
+// replaces the committed positions after an accepted step (the volume correction), as
+// ImmersedBoundaryOperator::correct_positions does. Every method that evaluates or commits is collective; when a membrane fails (a node
 // outside the box, an inverted element) every process throws SimulationError (the owner naming the membrane).
 // No global state.
 // Verified by: the tests ParallelRun.* (tests/test_parallel_run.cpp, 1 to 4 processes: the quick red-cell channel
 // with the midpoint RK2 scheme, with forward Euler, and with contact between cells of different processes, against
-// the one-process Simulation within 1e-10, repeated bitwise, with cells changing owner on 2 and 4 processes).
+// the one-process Simulation within 1e-10, repeated bitwise, with cells changing owner on 2 and 4 processes; and with
+// a viscosity contrast λ = 5 and the volume correction).
+#include <memory>
 #include <span>
 #include <string>
 #include <vector>
 
 #include "immerse/core/Vec3.hpp"
 #include "immerse/coupling/SlabIBCoupler.hpp"
+#include "immerse/coupling/SlabViscosityIndicator.hpp"
 #include "immerse/fluid/FluidState.hpp"
 #include "immerse/fluid/SlabNavierStokesSolver.hpp"
 #include "immerse/grid/FaceField.hpp"
@@ -56,12 +62,13 @@ class DistributedOperator final : public CoupledOperator {
  public:
   /// `membranes`: the force objects of all membranes, by global index (kept by pointer); X0 and `reference` their
   /// initial and reference positions (every process passes the same); `fluid_state` this process's slab state
-  /// (SlabNavierStokesSolver::scatter); the membranes repel each other and the walls by `contact` (off by default).
-  /// `fluid` and `coupler` are kept by reference. Collective.
+  /// (SlabNavierStokesSolver::scatter); the membranes repel each other and the walls by `contact` (off by default);
+  /// viscosity_ratio holds each membrane's λ = μ_in/μ_out (empty: all 1; any λ ≠ 1 needs a fluid solver with
+  /// variable viscosity). `fluid` and `coupler` are kept by reference. Collective.
   DistributedOperator(SlabNavierStokesSolver& fluid, SlabIBCoupler& coupler,
                       std::vector<const ElasticMembrane*> membranes, std::span<const std::vector<Vec3>> X0,
                       std::span<const std::vector<Vec3>> reference, FluidState fluid_state,
-                      const ContactSettings& contact = {});
+                      const ContactSettings& contact = {}, std::vector<double> viscosity_ratio = {});
   DistributedOperator(const DistributedOperator&) = delete;  // its ownership refers to the fluid's decomposition
   DistributedOperator& operator=(const DistributedOperator&) = delete;
 
@@ -84,8 +91,14 @@ class DistributedOperator final : public CoupledOperator {
   const MembraneOwnership& ownership() const { return ownership_; }
   /// This process's slab of the committed fluid state.
   const FluidState& fluid_state() const { return committed_; }
-  /// Membranes moved to another process by the commits so far (the same on every process).
+  /// Membranes moved to another process by the commits and corrections so far (the same on every process).
   int migrations() const { return migrations_; }
+  /// χ of the last trial on this process's slab (empty without a viscosity contrast).
+  const Array3& viscosity_indicator() const { return chi_; }
+  /// Replaces the committed positions of the owned nodes by X (concatenated as positions()) after an accepted step:
+  /// the node velocities become J(X) u^n of the committed fluid, which is not changed, and the membranes whose
+  /// centroid changed slab migrate, so size() may change. Collective.
+  void correct_positions(std::span<const Vec3> X);
 
  private:
   static std::span<const double> flat(const std::vector<Vec3>& v) {
@@ -99,6 +112,8 @@ class DistributedOperator final : public CoupledOperator {
   void add_contact_forces(std::span<const Vec3> Xf);
   /// Forces at Xf, spreading and the fluid step into trial_ (theta = 1 only). Collective.
   void trial_step(std::span<const double> Xf, double theta, double dt);
+  /// chi_ at the midpoints (X^n + Xf)/2 of the owned membranes (with a viscosity contrast). Collective.
+  void update_indicator(std::span<const Vec3> Xf);
 
   SlabNavierStokesSolver& fluid_;
   SlabIBCoupler& coupler_;
@@ -115,6 +130,9 @@ class DistributedOperator final : public CoupledOperator {
   std::vector<Vec3> F_;              ///< nodal forces of the owned nodes
   std::vector<std::vector<Vec3>> Fm_;  ///< work: one membrane's forces
   std::vector<double> trial_X_;      ///< the Xf of the last completed trial (empty when none)
+  std::unique_ptr<SlabViscosityIndicator> indicator_;  ///< with a viscosity contrast
+  std::vector<std::vector<Vec3>> Xmid_;              ///< midpoint positions of the owned membranes in a trial
+  Array3 chi_;                                       ///< χ of the last trial (slab)
   std::size_t solves_ = 0;
   int migrations_ = 0;
 };

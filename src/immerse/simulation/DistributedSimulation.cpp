@@ -7,6 +7,7 @@
 
 #include "immerse/core/Error.hpp"
 #include "immerse/coupling/DeltaKernel.hpp"
+#include "immerse/membrane/VolumeCorrection.hpp"
 #include "immerse/simulation/RunSetup.hpp"
 
 namespace immerse {
@@ -20,16 +21,6 @@ const io::Config& distributable(const io::Config& config) {
     throw InputError("time.scheme = \"" + scheme +
                      "\": a distributed run takes the explicit schemes \"euler\" and \"rk2\" only (the implicit "
                      "schemes' vectors are not distributed yet)");
-  for (std::size_t i = 0; i < config.count("membrane"); ++i) {
-    const io::Config& m = config.entry("membrane", i);
-    const std::string name = "membrane[" + std::to_string(i) + "]";
-    if (m.get<double>("viscosity_ratio") != 1.0)
-      throw InputError(name + ".viscosity_ratio = " + m.value_text("viscosity_ratio") +
-                       ": a viscosity contrast (variable viscosity) is not distributed yet (run in one process)");
-    if (m.get<std::string>("volume_correction") != "none")
-      throw InputError(name + ".volume_correction = " + m.value_text("volume_correction") +
-                       ": the volume correction is not distributed yet (run in one process)");
-  }
   return config;
 }
 
@@ -49,7 +40,8 @@ DistributedSimulation::DistributedSimulation(const io::Config& config, Communica
   for (const auto& m : membranes_.membranes) ms.push_back(m.get());
   op_ = std::make_unique<DistributedOperator>(
       fluid_, coupler_, std::move(ms), membranes_.initial, membranes_.references,
-      fluid_.scatter(run_initial_fluid_state(config_, grid_, fluid_.params())), run_contact_settings(config_));
+      fluid_.scatter(run_initial_fluid_state(config_, grid_, fluid_.params())), run_contact_settings(config_),
+      membranes_.viscosity_ratio);
   integrator_ = make_integrator(config_.get<std::string>("time.scheme"), run_solver_settings(config_));
 }
 
@@ -62,11 +54,43 @@ void DistributedSimulation::advance() {
   where << "step " << step_ + 1 << ", t = " << time() << ": ";
   try {
     integrator_->step(*op_, dt);
+    correct_volumes();
   } catch (const SimulationError& e) {
     throw SimulationError(where.str() + e.what());
   }
   ++step_;
   check_stability();
+}
+
+void DistributedSimulation::correct_volumes() {
+  // As Simulation after an accepted step: each owner shifts its membranes with volume_correction = "normal_shift"
+  // back to their initial volume, then the node velocities are interpolated at the new positions.
+  const auto& corrected = membranes_.corrected_volume;
+  if (std::ranges::none_of(corrected, [](const auto& v) { return v.has_value(); })) return;
+  const auto flat = op_->positions();
+  std::vector<Vec3> X(flat.size() / 3);
+  for (std::size_t i = 0; i < X.size(); ++i) X[i] = {flat[3 * i], flat[3 * i + 1], flat[3 * i + 2]};
+  const auto offsets = op_->membrane_offsets();
+  const auto& owned = op_->ownership().owned();
+  std::string error;
+  std::vector<Vec3> Xm;
+  for (std::size_t k = 0; k < owned.size() && error.empty(); ++k) {
+    const auto m = static_cast<std::size_t>(owned[k].id);
+    if (!corrected[m]) continue;
+    const auto first = X.begin() + static_cast<std::ptrdiff_t>(offsets[k] / 3),
+               last = X.begin() + static_cast<std::ptrdiff_t>(offsets[k + 1] / 3);
+    Xm.assign(first, last);
+    try {
+      normal_shift(membranes_.meshes[m], Xm, *corrected[m]);
+    } catch (const SimulationError& e) {
+      error = "membrane[" + std::to_string(m) + "] " + e.what();
+    }
+    std::copy(Xm.begin(), Xm.end(), first);
+  }
+  const Communicator& comm = fluid_.decomposition().communicator();
+  if (comm.sum(error.empty() ? 0.0 : 1.0) > 0)
+    throw SimulationError(error.empty() ? std::string("the volume correction of another process failed") : error);
+  op_->correct_positions(X);
 }
 
 void DistributedSimulation::check_stability() const {

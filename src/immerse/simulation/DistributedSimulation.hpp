@@ -8,16 +8,20 @@
 //
 // Time stepping: time.scheme = "euler" (ForwardEuler) or "rk2" (MidpointRK2), the same integrator objects as the
 // one-process run, with the constant step time.dt (the last one shortened to end at time.end, as AdaptiveStepper
-// does; an explicit scheme never rejects a step). The result equals Simulation's to round-off (the spreading sums,
-// see DistributedOperator.hpp) and is bitwise the same in every run with the same number of processes.
+// does; an explicit scheme never rejects a step). A viscosity contrast (viscosity_ratio ≠ 1) runs as in Simulation:
+// the variable-viscosity fluid step on the slabs with χ at each trial's midpoint (DistributedOperator). With
+// volume_correction = "normal_shift" each owner shifts its membranes back to their initial volume after every
+// accepted step (normal_shift of VolumeCorrection.hpp), then the node velocities are J(X) u^n at the shifted
+// positions, as Simulation does. The result equals Simulation's to round-off (the spreading sums, see
+// DistributedOperator.hpp) and is bitwise the same in every run with the same number of processes.
 //
 // Refused with InputError, as not distributed yet: the implicit schemes (JFNK, Anderson, L-BFGS and BFGS need their
-// vectors distributed, PETSc parallel vectors), a membrane with viscosity_ratio ≠ 1 (the variable-viscosity fluid
-// step) and volume_correction = "normal_shift". Output, checkpoints and `immerse run` under mpirun are not part of
+// vectors distributed, PETSc parallel vectors). Output, checkpoints and `immerse run` under mpirun are not part of
 // it: a caller gathers what it needs (gather_positions(), gather_fluid_state()).
 // Construction and advance() are collective over the communicator. No global state.
 // Verified by: the tests ParallelRun.* (tests/test_parallel_run.cpp, 1 to 4 processes: the quick red-cell channel
-// against the one-process Simulation within 1e-10, repeated bitwise, the refusals).
+// against the one-process Simulation within 1e-10, repeated bitwise, also with λ = 5 cells and the volume correction;
+// the refusals).
 #include <memory>
 #include <vector>
 
@@ -62,6 +66,8 @@ class DistributedSimulation {
 
  private:
   void check_stability() const;
+  /// The volume correction of the owned membranes after an accepted step. Collective.
+  void correct_volumes();
 
   io::Config config_;
   double dt_, end_time_, max_speed_;
