@@ -169,12 +169,24 @@ void DistributedOperator::add_contact_forces(std::span<const Vec3> Xf) {
 }
 
 void DistributedOperator::trial_step(std::span<const double> Xf, double theta, double dt) {
-  if (theta != 1.0)
-    throw std::logic_error("DistributedOperator: only the explicit schemes (theta = 1) are distributed");
   trial_X_.clear();
+  if (theta < 1.0 && !start_valid_) {  // S(X^n) f(X^n), once per step unless the last trial left it
+    nodal_forces(X_);
+    coupler_.spread_force(X_, F_, force_start_);
+    start_valid_ = true;
+  }
   nodal_forces(nodes(Xf));
   coupler_.spread_force(nodes(Xf), F_, force_);
-  fluid_.step(committed_, force_, dt, trial_);
+  if (theta < 1.0) {  // F^{n+1/2} = theta S(Xf) f(Xf) + (1 - theta) S(X^n) f(X^n), as ImmersedBoundaryOperator
+    mixed_ = force_;
+    for (int d = 0; d < 3; ++d) {
+      auto& o = mixed_[d].values();
+      const auto& x = force_[d].values();
+      const auto& y = force_start_[d].values();
+      for (std::size_t i = 0; i < o.size(); ++i) o[i] = theta * x[i] + (1.0 - theta) * y[i];
+    }
+  }
+  fluid_.step(committed_, theta < 1.0 ? mixed_ : force_, dt, trial_);
   ++solves_;
 }
 
@@ -210,6 +222,10 @@ bool DistributedOperator::trial_matches(std::span<const double> X) const {
 
 void DistributedOperator::commit(std::span<const double> X, double) {
   std::swap(committed_, trial_);
+  // A trial driven by X^{n+1} itself (an implicit step's last) leaves S(X^{n+1}) f(X^{n+1}), the next step's start
+  // force: a slab field, which does not depend on which process owns which membrane.
+  start_valid_ = trial_matches(X);
+  if (start_valid_) std::swap(force_start_, force_);
   ownership_.set_owned_positions(nodes(X));
   migrations_ += ownership_.migrate();
   refresh();
