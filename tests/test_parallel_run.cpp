@@ -45,14 +45,20 @@ constexpr int kRk2Steps = 20;
 constexpr int kEulerSteps = 5;
 constexpr int kContactSteps = 10;
 #endif
-// The implicit schemes: TBD.
-constexpr double kImplicitDt = 1e-4;
+// The implicit schemes at the same step, with a Newton tolerance tight enough that every step iterates (at 1e-8 the
+// extrapolated guess already meets it at this step) and the guess errors the initial guess is corrected by are not
+// zero. The six cells that change owner on 2 and 4 processes do so in the first step, with X^{n-1} (the guess
+// errors, which move the same way, are checked in ParallelCoupling.MigrationMovesMembranesToTheirNewOwners).
+constexpr double kImplicitDt = kDt;
+const std::string kImplicitTolerance = "solver.newton_rtol=1e-11";
 #if defined(__SANITIZE_ADDRESS__)
-constexpr int kImplicitSteps = 3;
+constexpr int kJfnkSteps = 3;
+constexpr int kAndersonSteps = 3;
 constexpr int kLbfgsSteps = 3;
 #else
-constexpr int kImplicitSteps = 20;
-constexpr int kLbfgsSteps = 20;
+constexpr int kJfnkSteps = 20;
+constexpr int kAndersonSteps = 10;
+constexpr int kLbfgsSteps = 5;
 #endif
 
 io::Config channel(const std::string& scheme, int steps, const std::vector<std::string>& more = {}, double dt = kDt) {
@@ -246,7 +252,6 @@ ImplicitResult run_implicit_distributed(const io::Config& config, int steps) {
     const StepRecord rec = sim.advance();
     r.counts.push_back({rec.dt, rec.rejected, rec.stats.newton_its, rec.stats.gmres_its, rec.stats.fluid_solves});
   }
-  EXPECT_TRUE(sim.finished());
   r.positions = sim.gather_positions();
   r.fluid = sim.gather_fluid_state();
   const GuessErrorPredictor& errors = sim.integrator().guess_errors();
@@ -275,11 +280,27 @@ std::string totals(const std::vector<StepCounts>& c) {
          std::to_string(solves) + " fluid solves, " + std::to_string(rejected) + " rejected";
 }
 
+// Agreement with the one-process run beyond the positions' 1e-10 (relative to the largest coordinate): of the
+// displacements and the velocity (relative to the largest), and of the stored guess errors (relative to the largest).
+struct Tolerances {
+  double displacement, guess_error;
+};
+// Anderson and L-BFGS combine values of g: the round-off of the distributed sums stays round-off.
+constexpr Tolerances kRoundOff{1e-10, 1e-7};
+// JFNK differentiates g by finite differences (eq. 37): a position differing in its last bit changes the rounding of
+// X + eps y, by about ulp(X) / (eps |y_i|) ~ 1e-6 of each component of the product (|X| ~ 100 h, eps ~ 2e-6 h over
+// 6e4 unknowns). The Newton corrections then differ by that fraction, the converged positions by about 1e-9 of the
+// displacement, the guess errors (the corrections beyond the extrapolation) by about 1e-6.
+constexpr Tolerances kFiniteDifference{1e-8, 1e-5};
+
 // An implicit scheme distributed against the one-process Simulation: positions and velocities within 1e-10, the
 // same steps and iteration counts, and the same bits when repeated.
-void compare_implicit_with_serial(const std::string& scheme, double dt, int steps) {
+void compare_implicit_with_serial(const std::string& scheme, int steps, const Tolerances& tol) {
+  const double dt = kImplicitDt;
+  const std::vector<std::string> more{kImplicitTolerance};
   const Communicator comm = Communicator::world();
-  const io::Config config = channel(scheme, steps, {}, dt);
+  // time.end one step beyond: every step has the same dt (the recurrence of the initial guess needs that).
+  const io::Config config = channel(scheme, steps + 1, more, dt);
   const ImplicitResult a = run_implicit_distributed(config, steps);
   const ImplicitResult b = run_implicit_distributed(config, steps);
   ASSERT_EQ(a.positions.size(), b.positions.size());
@@ -304,7 +325,6 @@ void compare_implicit_with_serial(const std::string& scheme, double dt, int step
     counts.push_back({rec.dt, rec.rejected, rec.stats.newton_its, rec.stats.gmres_its, rec.stats.fluid_solves});
   }
   const double serial_seconds = seconds_since(t0);
-  EXPECT_TRUE(serial.finished());
   ASSERT_EQ(counts.size(), a.counts.size());
   for (std::size_t s = 0; s < counts.size(); ++s) {
     EXPECT_EQ(a.counts[s].dt, counts[s].dt) << "step " << s + 1;
@@ -347,29 +367,29 @@ void compare_implicit_with_serial(const std::string& scheme, double dt, int step
   std::printf(
       "[ParallelRun] %s, %d steps of %g s on %d processes: positions %.2e (relative to the largest coordinate), "
       "displacements %.2e (relative to the largest, %.3e m), velocity %.2e (relative to the largest), guess errors "
-      "%.2e (relative to the largest, %.3e m); %s (one process: %s); cells that changed owner: %d; distributed "
-      "%.1f s per run, serial %.1f s\n",
-      scheme.c_str(), steps, dt, comm.size(), dx / x_max, d_moved / moved, moved, du / u_max, de / e_max, e_max,
+      "%.2e (relative to the largest, %.3e m); %s (one process: %s); cells that changed owner: %d; distributed %.1f "
+      "s per run, serial %.1f s\n",
+      (scheme + (more.empty() ? "" : " " + more[0])).c_str(), steps, dt, comm.size(), dx / x_max, d_moved / moved, moved, du / u_max, de / e_max, e_max,
       totals(a.counts).c_str(), totals(counts).c_str(), a.migrations, a.seconds, serial_seconds);
   EXPECT_GT(moved, 0.0);
   EXPECT_LE(dx / x_max, 1e-10);
-  EXPECT_LE(d_moved / moved, 1e-10);
-  EXPECT_LE(du / u_max, 1e-10);
-  EXPECT_LE(de / e_max, 1e-6);
+  EXPECT_LE(d_moved / moved, tol.displacement);
+  EXPECT_LE(du / u_max, tol.displacement);
+  EXPECT_LE(de / e_max, tol.guess_error);
 }
 
 }  // namespace
 
 TEST(ParallelRun, RedCellChannelJfnkEqualsTheOneProcessRun) {
-  compare_implicit_with_serial("jfnk", kImplicitDt, kImplicitSteps);
+  compare_implicit_with_serial("jfnk", kJfnkSteps, kFiniteDifference);
 }
 
 TEST(ParallelRun, RedCellChannelAndersonEqualsTheOneProcessRun) {
-  compare_implicit_with_serial("anderson", kImplicitDt, kImplicitSteps);
+  compare_implicit_with_serial("anderson", kAndersonSteps, kRoundOff);
 }
 
 TEST(ParallelRun, RedCellChannelLbfgsEqualsTheOneProcessRun) {
-  compare_implicit_with_serial("lbfgs", kImplicitDt, kLbfgsSteps);
+  compare_implicit_with_serial("lbfgs", kLbfgsSteps, kRoundOff);
 }
 
 // A bound on the speed below the flow's: every process stops with a SimulationError (the owners naming the node).
