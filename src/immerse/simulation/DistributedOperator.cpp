@@ -170,6 +170,7 @@ void DistributedOperator::add_contact_forces(std::span<const Vec3> Xf) {
 
 void DistributedOperator::trial_step(std::span<const double> Xf, double theta, double dt) {
   trial_X_.clear();
+  trial_done_ = false;
   if (theta < 1.0 && !start_valid_) {  // S(X^n) f(X^n), once per step unless the last trial left it
     nodal_forces(X_);
     coupler_.spread_force(X_, F_, force_start_);
@@ -195,6 +196,7 @@ void DistributedOperator::trial_velocity(std::span<const double> Xf, double thet
   trial_step(Xf, theta, dt);
   coupler_.interpolate_velocity(trial_.u, nodes(Xi), nodes(U));
   trial_X_.assign(Xf.begin(), Xf.end());
+  trial_done_ = true;
 }
 
 void DistributedOperator::trial_mean_velocity(std::span<const double> Xf, std::span<const double> Xi, double dt,
@@ -210,6 +212,7 @@ void DistributedOperator::trial_mean_velocity(std::span<const double> Xf, std::s
   }
   coupler_.interpolate_velocity(mean_, nodes(Xi), nodes(U));
   trial_X_.assign(Xf.begin(), Xf.end());
+  trial_done_ = true;
 }
 
 void DistributedOperator::committed_velocity(std::span<const double> Xi, std::span<double> U) {
@@ -217,14 +220,15 @@ void DistributedOperator::committed_velocity(std::span<const double> Xi, std::sp
 }
 
 bool DistributedOperator::trial_matches(std::span<const double> X) const {
-  return !trial_X_.empty() && std::ranges::equal(trial_X_, X);
+  return trial_done_ && std::ranges::equal(trial_X_, X);
 }
 
 void DistributedOperator::commit(std::span<const double> X, double) {
   std::swap(committed_, trial_);
   // A trial driven by X^{n+1} itself (an implicit step's last) leaves S(X^{n+1}) f(X^{n+1}), the next step's start
   // force: a slab field, which does not depend on which process owns which membrane.
-  start_valid_ = trial_matches(X);
+  // Agreed by all processes (a process's part may match where another's does not, or be empty).
+  start_valid_ = !any_failed(fluid_.decomposition().communicator(), !trial_matches(X));
   if (start_valid_) std::swap(force_start_, force_);
   ownership_.set_owned_positions(nodes(X));
   migrations_ += ownership_.migrate();
@@ -232,6 +236,7 @@ void DistributedOperator::commit(std::span<const double> X, double) {
   U_.resize(X_.size());
   coupler_.interpolate_velocity(committed_.u, X_, U_);
   trial_X_.clear();
+  trial_done_ = false;
 }
 
 }  // namespace immerse

@@ -81,6 +81,7 @@ class DistributedOperator final : public CoupledOperator {
   /// One interpolation, of the mean field (u^n + u^{n+1}) / 2.
   void trial_mean_velocity(std::span<const double> Xf, std::span<const double> Xi, double dt,
                            std::span<double> U) override;
+  /// This process's part only: callers that act on the answer collectively agree on it first.
   bool trial_matches(std::span<const double> X) const override;
   void commit(std::span<const double> X, double dt) override;
   std::size_t fluid_solves() const override { return solves_; }
@@ -122,7 +123,8 @@ class DistributedOperator final : public CoupledOperator {
   FaceField mean_;                   ///< (u^n + u^{n+1}) / 2 of trial_mean_velocity (slab)
   std::vector<Vec3> F_;              ///< nodal forces of the owned nodes
   std::vector<std::vector<Vec3>> Fm_;  ///< work: one membrane's forces
-  std::vector<double> trial_X_;      ///< the Xf of the last completed trial (empty when none)
+  std::vector<double> trial_X_;      ///< the Xf of the last completed trial, when trial_done_
+  bool trial_done_ = false;          ///< a flag: a process owning no membrane has an empty trial_X_ too
   std::size_t solves_ = 0;
   int migrations_ = 0;
 };

@@ -360,7 +360,7 @@ SolverStats SnesIntegrator::step(CoupledOperator& op, double dt) {
   for (std::size_t i = 0; i < n_; ++i) X_[i] = scale_ * xr[i];
   IMMERSE_PETSC(VecRestoreArrayRead(x_, &xr));
   // The trial fluid state must be the one driven by the accepted positions.
-  if (!residual.trial_matches(X_)) residual(X_, g_);
+  if (any_process(!residual.trial_matches(X_))) residual(X_, g_);  // distributed: agreed, as it is collective
   remember(op, dt, X_);
   op.commit(X_, dt);
   stats.fluid_solves = op.fluid_solves() - solves0;
