@@ -5,7 +5,9 @@
 // 32 biconcave cells of 642 nodes, Yeoh law, body force, contact within one grid spacing) with the explicit midpoint
 // RK2 scheme at dt = kDt, and with forward Euler for a few steps: the positions gathered from the processes equal the
 // one-process Simulation of the same configuration (on rank 0) within 1e-10 relative, and so do the velocity field
-// and its mean along the flow; the distributed run repeated gives the same bits. Along z the 24 cell planes give
+// and its mean along the flow; the distributed run repeated gives the same bits. The implicit schemes JFNK, Anderson
+// and L-BFGS (PETSc MPI vectors) take the same iterations at every step as the one-process run, with positions within
+// 1e-10 and the stored guess errors of the initial guess close to the one-process ones. Along z the 24 cell planes give
 // slabs of 12/12 planes on 2 processes, 8/8/8 on 3 and 6/6/6/6 on 4: the middle layer of cells lies at z = Lz/2, on
 // the slab boundary of 2 and 4 processes, where cells change owner as they move.
 #include <gtest/gtest.h>
