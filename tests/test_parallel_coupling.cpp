@@ -287,8 +287,9 @@ TEST(ParallelCoupling, SpreadingAndInterpolationEqualTheSerialCouplerAndRepeatBi
 }
 
 // (d): membranes moved rigidly across a slab boundary (and, periodic, across the periodic z boundary) migrate to the
-// owner of their new centroid; the gathered positions are the moved ones bitwise, and spreading after the migration
-// still equals IBCoupler's.
+// owner of their new centroid; the gathered positions are the moved ones bitwise, per-node values sent after them
+// (MembraneOwnership::follow, as an integrator's history) arrive with them, and spreading after the migration still
+// equals IBCoupler's.
 TEST(ParallelCoupling, MigrationMovesMembranesToTheirNewOwners) {
   const Communicator comm = Communicator::world();
   for (Boundary z : {W, P}) {
@@ -313,8 +314,26 @@ TEST(ParallelCoupling, MigrationMovesMembranesToTheirNewOwners) {
       expected_moves += expected_owner(g, comm.size(), before) != expected_owner(g, comm.size(), after);
     }
     for (OwnedMembrane& o : ownership.owned()) o.positions = moved[o.id];
+    // Three arrays of per-node values (membrane, node, component and array encoded) over the owned membranes.
+    const auto value = [](int m, std::size_t i, int k, std::size_t a) {
+      return 1e4 * m + 4.0 * static_cast<double>(i) + k + 0.25 * static_cast<double>(a);
+    };
+    constexpr std::size_t arrays = 3;
+    std::vector<double> before;
+    for (std::size_t a = 0; a < arrays; ++a)
+      for (const OwnedMembrane& o : ownership.owned())
+        for (std::size_t i = 0; i < o.positions.size(); ++i)
+          for (int k = 0; k < 3; ++k) before.push_back(value(o.id, i, k, a));
     const int count = ownership.migrate();
     EXPECT_EQ(count, expected_moves);
+    // The values moved with their membranes: the same arrays over the membranes owned now, in their order.
+    const std::vector<double> now = ownership.follow(before, arrays);
+    ASSERT_EQ(now.size(), arrays * 3 * ownership.num_owned_nodes());
+    std::size_t at = 0;
+    for (std::size_t a = 0; a < arrays; ++a)
+      for (const OwnedMembrane& o : ownership.owned())
+        for (std::size_t i = 0; i < o.positions.size(); ++i)
+          for (int k = 0; k < 3; ++k) ASSERT_EQ(now[at++], value(o.id, i, k, a)) << "membrane " << o.id;
     if (comm.size() > 1) {
       EXPECT_EQ(count, static_cast<int>(moves.size()));
     }

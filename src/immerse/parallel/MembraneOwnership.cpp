@@ -48,6 +48,7 @@ MembraneOwnership::MembraneOwnership(const SlabDecomposition& slabs, std::span<c
     offset += positions[m].size();
     if (owner(positions[m]) == rank) owned_.push_back({static_cast<int>(m), positions[m], reference[m]});
   }
+  for (const OwnedMembrane& m : owned_) moves_.push_back({m.id, rank});
 }
 
 Vec3 MembraneOwnership::centroid(std::span<const Vec3> X) {
@@ -93,8 +94,10 @@ int MembraneOwnership::migrate() {
   // Per destination: index, then positions and reference positions (3 n_m values each) of each leaving membrane.
   std::vector<std::vector<double>> out(static_cast<std::size_t>(size));
   std::vector<OwnedMembrane> staying;
+  moves_.clear();
   for (OwnedMembrane& m : owned_) {
     const int to = owner(m.positions);
+    moves_.push_back({m.id, to});
     if (to == rank) {
       staying.push_back(std::move(m));
       continue;
@@ -128,6 +131,68 @@ int MembraneOwnership::migrate() {
   }
   std::sort(owned_.begin(), owned_.end(), [](const OwnedMembrane& a, const OwnedMembrane& b) { return a.id < b.id; });
   return static_cast<int>(comm.sum(static_cast<double>(leaving)));
+}
+
+std::vector<double> MembraneOwnership::follow(std::span<const double> before, std::size_t arrays) const {
+  const Communicator& comm = slabs_.communicator();
+  const int size = comm.size(), rank = comm.rank();
+  std::size_t nodes_before = 0;
+  for (const Move& m : moves_) nodes_before += static_cast<std::size_t>(node_counts_[m.id]);
+  if (before.size() != arrays * 3 * nodes_before)
+    throw std::invalid_argument("MembraneOwnership::follow: " + std::to_string(before.size()) + " values for " +
+                                std::to_string(arrays) + " arrays over " + std::to_string(nodes_before) + " nodes");
+  const std::size_t stride = 3 * nodes_before;  // between the arrays of `before`
+  // Where each membrane's values begin in the first array: staying ones in `before`, arriving ones in `recv`.
+  std::vector<const double*> from(node_counts_.size(), nullptr);
+  std::vector<std::size_t> step(node_counts_.size(), 0);  // from one array to the next
+  std::vector<std::vector<double>> out(static_cast<std::size_t>(size));
+  std::size_t at = 0;
+  for (const Move& m : moves_) {
+    const std::size_t n = 3 * static_cast<std::size_t>(node_counts_[m.id]);
+    if (m.to == rank) {
+      from[m.id] = before.data() + at;
+      step[m.id] = stride;
+    } else {
+      std::vector<double>& o = out[m.to];
+      o.push_back(static_cast<double>(m.id));
+      for (std::size_t a = 0; a < arrays; ++a) {
+        const auto first = before.begin() + static_cast<std::ptrdiff_t>(a * stride + at);
+        o.insert(o.end(), first, first + static_cast<std::ptrdiff_t>(n));
+      }
+    }
+    at += n;
+  }
+  std::vector<int> send_counts(size), send_offsets(size, 0), recv_counts(size), recv_offsets(size, 0);
+  for (int r = 0; r < size; ++r) send_counts[r] = static_cast<int>(out[r].size());
+  check(MPI_Alltoall(send_counts.data(), 1, MPI_INT, recv_counts.data(), 1, MPI_INT, comm.comm()), "MPI_Alltoall");
+  for (int r = 1; r < size; ++r) {
+    send_offsets[r] = send_offsets[r - 1] + send_counts[r - 1];
+    recv_offsets[r] = recv_offsets[r - 1] + recv_counts[r - 1];
+  }
+  std::vector<double> send, recv(static_cast<std::size_t>(recv_offsets[size - 1]) + recv_counts[size - 1]);
+  for (const std::vector<double>& o : out) send.insert(send.end(), o.begin(), o.end());
+  check(MPI_Alltoallv(send.data(), send_counts.data(), send_offsets.data(), MPI_DOUBLE, recv.data(),
+                      recv_counts.data(), recv_offsets.data(), MPI_DOUBLE, comm.comm()),
+        "MPI_Alltoallv");
+  for (std::size_t q = 0; q < recv.size();) {
+    const auto id = static_cast<std::size_t>(recv[q]);
+    const std::size_t n = 3 * static_cast<std::size_t>(node_counts_.at(id));
+    from[id] = recv.data() + q + 1;
+    step[id] = n;
+    q += 1 + arrays * n;
+  }
+  const std::size_t nodes_now = num_owned_nodes();
+  std::vector<double> now(arrays * 3 * nodes_now);
+  at = 0;
+  for (const OwnedMembrane& m : owned_) {
+    const std::size_t n = 3 * m.positions.size();
+    if (!from[m.id])
+      throw std::logic_error("MembraneOwnership::follow: no values for membrane " + std::to_string(m.id));
+    for (std::size_t a = 0; a < arrays; ++a)
+      std::copy_n(from[m.id] + a * step[m.id], n, now.begin() + static_cast<std::ptrdiff_t>(a * 3 * nodes_now + at));
+    at += n;
+  }
+  return now;
 }
 
 std::vector<Vec3> MembraneOwnership::gather(std::span<const Vec3> owned_values) const {

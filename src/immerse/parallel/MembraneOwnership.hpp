@@ -15,7 +15,8 @@
 //
 // Migration (migrate()) recomputes every owned membrane's owner from its current positions and sends those that
 // changed, index, positions and reference positions, to their new owners in one MPI_Alltoallv; each process then
-// sorts its membranes by index again. The result depends only on the positions, not on message timing. gather()
+// sorts its membranes by index again. The result depends only on the positions, not on message timing. follow() sends
+// other per-node values (say an integrator's history) the way the last migrate() sent the membranes. gather()
 // assembles per-node values (positions, velocities) of all membranes in global membrane order on every process.
 // Collective: the constructor (only in that every process passes the same membranes), migrate(), gather() and
 // gather_positions() are called by every process of the decomposition's communicator.
@@ -67,6 +68,10 @@ class MembraneOwnership {
   /// Moves every membrane whose owner changed to its new owner; returns how many moved (the same on every rank).
   /// Collective.
   int migrate();
+  /// Per-node values that travel with the membranes: `before` holds `arrays` arrays of 3 values per node over the
+  /// membranes owned before the last migrate() (in their order then), concatenated; returns the same arrays over the
+  /// membranes owned now (an integrator's history, for instance). Collective.
+  std::vector<double> follow(std::span<const double> before, std::size_t arrays) const;
   /// Per-node values of this process's membranes (concatenated in owned() order) assembled for all membranes in
   /// global order, on every process. Collective.
   std::vector<Vec3> gather(std::span<const Vec3> owned_values) const;
@@ -78,6 +83,10 @@ class MembraneOwnership {
   std::vector<int> node_counts_;
   std::vector<std::size_t> node_offsets_;  ///< of membrane m in the global concatenation
   std::vector<OwnedMembrane> owned_;
+  struct Move {
+    int id, to;
+  };
+  std::vector<Move> moves_;  ///< the membranes owned before the last migrate(), in their order then, and their owners
 };
 
 }  // namespace immerse

@@ -189,13 +189,26 @@ void DistributedOperator::add_contact_forces(std::span<const Vec3> Xf) {
 }
 
 void DistributedOperator::trial_step(std::span<const double> Xf, double theta, double dt) {
-  if (theta != 1.0)
-    throw std::logic_error("DistributedOperator: only the explicit schemes (theta = 1) are distributed");
   trial_X_.clear();
+  trial_done_ = false;
+  if (theta < 1.0 && !start_valid_) {  // S(X^n) f(X^n), once per step unless the last trial left it
+    nodal_forces(X_);
+    coupler_.spread_force(X_, F_, force_start_);
+    start_valid_ = true;
+  }
   nodal_forces(nodes(Xf));
   coupler_.spread_force(nodes(Xf), F_, force_);
+  if (theta < 1.0) {  // F^{n+1/2} = theta S(Xf) f(Xf) + (1 - theta) S(X^n) f(X^n), as ImmersedBoundaryOperator
+    mixed_ = force_;
+    for (int d = 0; d < 3; ++d) {
+      auto& o = mixed_[d].values();
+      const auto& x = force_[d].values();
+      const auto& y = force_start_[d].values();
+      for (std::size_t i = 0; i < o.size(); ++i) o[i] = theta * x[i] + (1.0 - theta) * y[i];
+    }
+  }
   if (indicator_) update_indicator(nodes(Xf));
-  fluid_.step(committed_, force_, dt, trial_, indicator_ ? &chi_ : nullptr);
+  fluid_.step(committed_, theta < 1.0 ? mixed_ : force_, dt, trial_, indicator_ ? &chi_ : nullptr);
   ++solves_;
 }
 
@@ -204,6 +217,7 @@ void DistributedOperator::trial_velocity(std::span<const double> Xf, double thet
   trial_step(Xf, theta, dt);
   coupler_.interpolate_velocity(trial_.u, nodes(Xi), nodes(U));
   trial_X_.assign(Xf.begin(), Xf.end());
+  trial_done_ = true;
 }
 
 void DistributedOperator::trial_mean_velocity(std::span<const double> Xf, std::span<const double> Xi, double dt,
@@ -219,6 +233,7 @@ void DistributedOperator::trial_mean_velocity(std::span<const double> Xf, std::s
   }
   coupler_.interpolate_velocity(mean_, nodes(Xi), nodes(U));
   trial_X_.assign(Xf.begin(), Xf.end());
+  trial_done_ = true;
 }
 
 void DistributedOperator::committed_velocity(std::span<const double> Xi, std::span<double> U) {
@@ -233,20 +248,28 @@ void DistributedOperator::correct_positions(std::span<const Vec3> X) {
   U_.resize(X_.size());
   coupler_.interpolate_velocity(committed_.u, X_, U_);
   trial_X_.clear();
+  trial_done_ = false;
+  start_valid_ = false;  // S(X^n) f(X^n) at the corrected positions is computed when a trial needs it
 }
 
 bool DistributedOperator::trial_matches(std::span<const double> X) const {
-  return !trial_X_.empty() && std::ranges::equal(trial_X_, X);
+  return trial_done_ && std::ranges::equal(trial_X_, X);
 }
 
 void DistributedOperator::commit(std::span<const double> X, double) {
   std::swap(committed_, trial_);
+  // A trial driven by X^{n+1} itself (an implicit step's last) leaves S(X^{n+1}) f(X^{n+1}), the next step's start
+  // force: a slab field, which does not depend on which process owns which membrane.
+  // Agreed by all processes (a process's part may match where another's does not, or be empty).
+  start_valid_ = !any_failed(fluid_.decomposition().communicator(), !trial_matches(X));
+  if (start_valid_) std::swap(force_start_, force_);
   ownership_.set_owned_positions(nodes(X));
   migrations_ += ownership_.migrate();
   refresh();
   U_.resize(X_.size());
   coupler_.interpolate_velocity(committed_.u, X_, U_);
   trial_X_.clear();
+  trial_done_ = false;
 }
 
 }  // namespace immerse

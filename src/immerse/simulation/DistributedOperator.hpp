@@ -30,16 +30,20 @@
 //
 // Results. Membrane and contact forces and interpolation equal the serial ones bitwise for the same positions;
 // spreading adds in another order (SlabIBCoupler.hpp), so a run differs from the one-process run by round-off, and is
-// bitwise the same in every run with the same number of processes. Applied nodal forces are not distributed; the
-// implicit schemes, which need the residual's vectors distributed (PETSc), do not run on it. correct_positions()
-// replaces the committed positions after an accepted step (the volume correction), as
-// ImmersedBoundaryOperator::correct_positions does. Every method that evaluates or commits is collective; when a membrane fails (a node
-// outside the box, an inverted element) every process throws SimulationError (the owner naming the membrane).
-// No global state.
+// bitwise the same in every run with the same number of processes. Applied nodal forces are not distributed.
+// correct_positions() replaces the committed positions after an accepted step (the volume correction), as
+// ImmersedBoundaryOperator::correct_positions does.
+//
+// Implicit step. A trial with theta < 1 is driven, as in ImmersedBoundaryOperator, by
+// F^{n+1/2} = theta S(Xf) f(Xf) + (1 - theta) S(X^n) f(X^n) (eq. 31), the start force taken over from the last trial
+// when that was driven by X^{n+1} (an implicit step's is), else computed when a trial first needs it. The implicit
+// schemes (SnesIntegrator) run on it with PETSc MPI vectors whose local part is size(). Every method that evaluates
+// or commits is collective; when a membrane fails (a node outside the box, an inverted element) every process throws
+// SimulationError (the owner naming the membrane). No global state.
 // Verified by: the tests ParallelRun.* (tests/test_parallel_run.cpp, 1 to 4 processes: the quick red-cell channel
-// with the midpoint RK2 scheme, with forward Euler, and with contact between cells of different processes, against
-// the one-process Simulation within 1e-10, repeated bitwise, with cells changing owner on 2 and 4 processes; and with
-// a viscosity contrast λ = 5 and the volume correction).
+// with the midpoint RK2 scheme, with forward Euler, with JFNK, Anderson and L-BFGS, and with contact between cells of
+// different processes, against the one-process Simulation within 1e-10, repeated bitwise, with cells changing owner
+// on 2 and 4 processes; and with a viscosity contrast λ = 5 and the volume correction).
 #include <memory>
 #include <span>
 #include <string>
@@ -83,6 +87,7 @@ class DistributedOperator final : public CoupledOperator {
   /// One interpolation, of the mean field (u^n + u^{n+1}) / 2.
   void trial_mean_velocity(std::span<const double> Xf, std::span<const double> Xi, double dt,
                            std::span<double> U) override;
+  /// This process's part only: callers that act on the answer collectively agree on it first.
   bool trial_matches(std::span<const double> X) const override;
   void commit(std::span<const double> X, double dt) override;
   std::size_t fluid_solves() const override { return solves_; }
@@ -110,7 +115,7 @@ class DistributedOperator final : public CoupledOperator {
   void nodal_forces(std::span<const Vec3> Xf);
   /// Adds the contact forces of the owned nodes at Xf to F_. Collective.
   void add_contact_forces(std::span<const Vec3> Xf);
-  /// Forces at Xf, spreading and the fluid step into trial_ (theta = 1 only). Collective.
+  /// Forces at Xf, spreading and the fluid step into trial_ driven by F^{n+1/2} of (Xf, theta). Collective.
   void trial_step(std::span<const double> Xf, double theta, double dt);
   /// chi_ at the midpoints (X^n + Xf)/2 of the owned membranes (with a viscosity contrast). Collective.
   void update_indicator(std::span<const Vec3> Xf);
@@ -126,10 +131,14 @@ class DistributedOperator final : public CoupledOperator {
   std::vector<Vec3> X_, U_;          ///< committed positions and node velocities of the owned nodes
   FluidState committed_, trial_;     ///< slab states
   FaceField force_;                  ///< S(Xf) f(Xf) of the last trial (slab)
+  FaceField force_start_;            ///< S(X^n) f(X^n), when start_valid_ (slab)
+  bool start_valid_ = false;
+  FaceField mixed_;                  ///< F^{n+1/2} of the last trial with theta < 1 (slab)
   FaceField mean_;                   ///< (u^n + u^{n+1}) / 2 of trial_mean_velocity (slab)
   std::vector<Vec3> F_;              ///< nodal forces of the owned nodes
   std::vector<std::vector<Vec3>> Fm_;  ///< work: one membrane's forces
-  std::vector<double> trial_X_;      ///< the Xf of the last completed trial (empty when none)
+  std::vector<double> trial_X_;      ///< the Xf of the last completed trial, when trial_done_
+  bool trial_done_ = false;          ///< a flag: a process owning no membrane has an empty trial_X_ too
   std::unique_ptr<SlabViscosityIndicator> indicator_;  ///< with a viscosity contrast
   std::vector<std::vector<Vec3>> Xmid_;              ///< midpoint positions of the owned membranes in a trial
   Array3 chi_;                                       ///< χ of the last trial (slab)

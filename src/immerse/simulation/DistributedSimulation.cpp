@@ -1,6 +1,7 @@
 #include "immerse/simulation/DistributedSimulation.hpp"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <sstream>
 #include <string>
@@ -16,11 +17,9 @@ namespace {
 
 /// The configuration, refused (InputError) where it asks for what is not distributed yet.
 const io::Config& distributable(const io::Config& config) {
-  const std::string scheme = config.get<std::string>("time.scheme");
-  if (scheme != "euler" && scheme != "rk2")
-    throw InputError("time.scheme = \"" + scheme +
-                     "\": a distributed run takes the explicit schemes \"euler\" and \"rk2\" only (the implicit "
-                     "schemes' vectors are not distributed yet)");
+  if (config.get<std::string>("time.scheme") == "bfgs")
+    throw InputError("time.scheme = \"bfgs\": the dense quasi-Newton matrix of eq. (35) is not distributed (use "
+                     "\"jfnk\", \"anderson\" or \"lbfgs\", or run in one process)");
   return config;
 }
 
@@ -28,38 +27,70 @@ const io::Config& distributable(const io::Config& config) {
 
 DistributedSimulation::DistributedSimulation(const io::Config& config, Communicator comm)
     : config_(distributable(config)),
-      dt_(config.get<double>("time.dt")),
       end_time_(config.get<double>("time.end")),
       max_speed_(config.get<double>("time.max_speed")),
       grid_(run_grid(config)),
       fluid_(grid_, run_fluid_params(config), comm),
       coupler_(fluid_.decomposition(), delta_kernel(config.get<std::string>("coupling.kernel"))),
-      membranes_(build_membrane_set(config, grid_)) {
-  require(std::isfinite(dt_) && dt_ > 0, "time.dt", dt_, "a finite step > 0");
+      membranes_(build_membrane_set(config, grid_)),
+      stepper_(config.get<double>("time.dt"), config.get<double>("time.dt_min")) {
   std::vector<const ElasticMembrane*> ms;
   for (const auto& m : membranes_.membranes) ms.push_back(m.get());
   op_ = std::make_unique<DistributedOperator>(
       fluid_, coupler_, std::move(ms), membranes_.initial, membranes_.references,
       fluid_.scatter(run_initial_fluid_state(config_, grid_, fluid_.params())), run_contact_settings(config_),
       membranes_.viscosity_ratio);
-  integrator_ = make_integrator(config_.get<std::string>("time.scheme"), run_solver_settings(config_));
+  integrator_ = make_integrator(config_.get<std::string>("time.scheme"), run_solver_settings(config_),
+                                comm.comm());
+  integrator_->prepare(op_->size());
 }
 
 bool DistributedSimulation::finished() const { return time() >= end_time_ * (1 - 1e-12); }
 
-void DistributedSimulation::advance() {
-  const double dt = std::min(dt_, end_time_ - time());
+StepRecord DistributedSimulation::advance(const std::function<void(const std::string&)>& log) {
+  const auto t0 = std::chrono::steady_clock::now();
   std::ostringstream where;
   where.precision(10);
   where << "step " << step_ + 1 << ", t = " << time() << ": ";
+  const int migrated = op_->migrations();
+  StepRecord r;
   try {
-    integrator_->step(*op_, dt);
+    const auto acc = stepper_.advance(*integrator_, *op_, end_time_ - time(), [&](const std::string& msg) {
+      if (log) log(where.str() + msg);
+    });
+    r.stats = acc.stats;
+    r.dt = acc.dt;
+    r.rejected = acc.rejected;
+    // The history moves with membranes that changed owner in the commit, then again in the volume correction
+    // (follow() sends values the way the last migration sent the membranes).
+    if (op_->migrations() != migrated) follow_history();
+    const int corrected = op_->migrations();
     correct_volumes();
+    if (op_->migrations() != corrected) follow_history();
   } catch (const SimulationError& e) {
     throw SimulationError(where.str() + e.what());
   }
   ++step_;
+  r.step = step_;
+  r.time = time();
+  r.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   check_stability();
+  return r;
+}
+
+void DistributedSimulation::follow_history() {
+  MembraneIntegrator& in = *integrator_;
+  if (!(in.previous_dt() > 0)) return;  // no history yet (on every process alike)
+  // X^{n-1}, then the stored guess errors, oldest first: arrays over the unknowns of the membranes owned before the
+  // commit, moved with them.
+  const std::size_t count = in.guess_errors().count();
+  std::vector<double> before(in.previous_positions().begin(), in.previous_positions().end());
+  const std::vector<double> errors = in.guess_errors().errors();
+  before.insert(before.end(), errors.begin(), errors.end());
+  const std::vector<double> now = op_->ownership().follow(before, 1 + count);
+  const std::size_t n = op_->size();
+  in.set_history(std::vector<double>(now.begin(), now.begin() + static_cast<std::ptrdiff_t>(n)), in.previous_dt(),
+                 std::span<const double>(now).subspan(n), count);
 }
 
 void DistributedSimulation::correct_volumes() {

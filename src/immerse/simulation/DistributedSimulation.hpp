@@ -1,28 +1,33 @@
 #pragma once
-// One run distributed over the MPI processes of a communicator, with an explicit scheme: the grid cut into slabs of
-// z planes (SlabNavierStokesSolver, SlabIBCoupler), each membrane advanced by the process owning it
-// (DistributedOperator, MembraneOwnership), built from the same resolved configuration as Simulation with the same
-// code (run_grid, run_fluid_params, run_contact_settings, run_initial_fluid_state of RunSetup.hpp; the membranes,
-// packing included, of build_membrane_set): every process builds all membranes (meshes, reference positions, force
-// objects) and keeps the ones it owns as its unknowns.
+// One run distributed over the MPI processes of a communicator: the grid cut into slabs of z planes
+// (SlabNavierStokesSolver, SlabIBCoupler), each membrane advanced by the process owning it (DistributedOperator,
+// MembraneOwnership), built from the same resolved configuration as Simulation with the same code (run_grid,
+// run_fluid_params, run_contact_settings, run_initial_fluid_state of RunSetup.hpp; the membranes, packing included,
+// of build_membrane_set): every process builds all membranes (meshes, reference positions, force objects) and keeps
+// the ones it owns as its unknowns.
 //
-// Time stepping: time.scheme = "euler" (ForwardEuler) or "rk2" (MidpointRK2), the same integrator objects as the
-// one-process run, with the constant step time.dt (the last one shortened to end at time.end, as AdaptiveStepper
-// does; an explicit scheme never rejects a step). A viscosity contrast (viscosity_ratio ≠ 1) runs as in Simulation:
-// the variable-viscosity fluid step on the slabs with χ at each trial's midpoint (DistributedOperator). With
-// volume_correction = "normal_shift" each owner shifts its membranes back to their initial volume after every
-// accepted step (normal_shift of VolumeCorrection.hpp), then the node velocities are J(X) u^n at the shifted
-// positions, as Simulation does. The result equals Simulation's to round-off (the spreading sums, see
-// DistributedOperator.hpp) and is bitwise the same in every run with the same number of processes.
+// Time stepping: time.scheme = "euler" (ForwardEuler), "rk2" (MidpointRK2), or the implicit "jfnk", "anderson" and
+// "lbfgs" (SnesIntegrator on PETSc MPI vectors over the communicator, make_integrator's overload with one), the same
+// integrator classes as the one-process run, stepped by AdaptiveStepper as Simulation does (time.dt, halved on a
+// failed nonlinear solve down to time.dt_min, the last step shortened to end at time.end; an explicit scheme never
+// rejects a step). The integrator's history (X^{n-1} and the guess errors of GuessErrorPredictor, per membrane) moves
+// with the membranes when they change owner (MembraneOwnership::follow), so every membrane's initial guess is the
+// one-process run's. A viscosity contrast (viscosity_ratio ≠ 1) runs as in Simulation: the variable-viscosity fluid
+// step on the slabs with χ at each trial's midpoint (DistributedOperator). With volume_correction = "normal_shift"
+// each owner shifts its membranes back to their initial volume after every accepted step (normal_shift of
+// VolumeCorrection.hpp), then the node velocities are J(X) u^n at the shifted positions, as Simulation does. The
+// result equals Simulation's to round-off (the spreading sums, see DistributedOperator.hpp, and the order of the sums
+// in the solvers' norms) and is bitwise the same in every run with the same number of processes.
 //
-// Refused with InputError, as not distributed yet: the implicit schemes (JFNK, Anderson, L-BFGS and BFGS need their
-// vectors distributed, PETSc parallel vectors). Output, checkpoints and `immerse run` under mpirun are not part of
-// it: a caller gathers what it needs (gather_positions(), gather_fluid_state()).
+// Refused with InputError: the dense "bfgs" (its matrix spans all unknowns). Output and checkpoints are the caller's
+// (DistributedRun gathers what it needs: gather_positions(), gather_fluid_state()).
 // Construction and advance() are collective over the communicator. No global state.
 // Verified by: the tests ParallelRun.* (tests/test_parallel_run.cpp, 1 to 4 processes: the quick red-cell channel
-// against the one-process Simulation within 1e-10, repeated bitwise, also with λ = 5 cells and the volume correction;
-// the refusals).
+// with explicit and implicit schemes against the one-process Simulation within 1e-10, repeated bitwise, the same
+// iteration counts, also with λ = 5 cells and the volume correction; the refusals).
+#include <functional>
 #include <memory>
+#include <string>
 #include <vector>
 
 #include "immerse/core/Vec3.hpp"
@@ -34,6 +39,8 @@
 #include "immerse/parallel/Communicator.hpp"
 #include "immerse/simulation/DistributedOperator.hpp"
 #include "immerse/simulation/MembraneSet.hpp"
+#include "immerse/simulation/StepRecord.hpp"
+#include "immerse/timestep/AdaptiveStepper.hpp"
 #include "immerse/timestep/MembraneIntegrator.hpp"
 
 namespace immerse {
@@ -46,15 +53,18 @@ class DistributedSimulation {
   DistributedSimulation(const DistributedSimulation&) = delete;
   DistributedSimulation& operator=(const DistributedSimulation&) = delete;
 
-  /// Advances one step. SimulationError on every process when the run becomes unstable (a node not finite or faster
-  /// than time.max_speed, a membrane failing). Collective.
-  void advance();
+  /// Advances one accepted step, as Simulation::advance: an implicit step whose solve fails is halved and retried
+  /// (AdaptiveStepper; each rejection reported through `log`, on every process). SimulationError on every process
+  /// when the run becomes unstable (a node not finite or faster than time.max_speed, a membrane failing) or the
+  /// halved step would fall below time.dt_min (naming step, time and why). Collective.
+  StepRecord advance(const std::function<void(const std::string&)>& log = {});
   bool finished() const;
 
   long step() const { return step_; }
   double time() const { return op_->fluid_state().time; }
   const Grid& grid() const { return grid_; }
   const DistributedOperator& op() const { return *op_; }
+  const MembraneIntegrator& integrator() const { return *integrator_; }
   std::size_t num_membranes() const { return membranes_.membranes.size(); }
   /// Membranes moved between processes so far.
   int migrations() const { return op_->migrations(); }
@@ -68,15 +78,19 @@ class DistributedSimulation {
   void check_stability() const;
   /// The volume correction of the owned membranes after an accepted step. Collective.
   void correct_volumes();
+  /// After a migration: the integrator's history of the membranes (X^{n-1}, the guess errors) moved along, so that
+  /// each membrane's initial guess is the one-process run's. Collective.
+  void follow_history();
 
   io::Config config_;
-  double dt_, end_time_, max_speed_;
+  double end_time_, max_speed_;
   Grid grid_;
   SlabNavierStokesSolver fluid_;
   SlabIBCoupler coupler_;
   MembraneSet membranes_;
   std::unique_ptr<DistributedOperator> op_;
   std::unique_ptr<MembraneIntegrator> integrator_;
+  AdaptiveStepper stepper_;
   long step_ = 0;
 };
 

@@ -16,19 +16,11 @@
 #include "immerse/membrane/ElasticMembrane.hpp"
 #include "immerse/membrane/Mesh.hpp"
 #include "immerse/simulation/ImmersedBoundaryOperator.hpp"
+#include "immerse/simulation/StepRecord.hpp"
 #include "immerse/timestep/AdaptiveStepper.hpp"
 #include "immerse/timestep/MembraneIntegrator.hpp"
 
 namespace immerse {
-
-/// What one accepted step did (one row of diagnostics.csv before the membrane columns).
-struct StepRecord {
-  long step = 0;
-  double time = 0, dt = 0;
-  SolverStats stats;
-  int rejected = 0;
-  double wall_seconds = 0;
-};
 
 class Simulation {
  public:

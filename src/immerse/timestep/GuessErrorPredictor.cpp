@@ -150,8 +150,15 @@ void GuessErrorPredictor::restore(std::span<const double> errors, std::size_t n,
   if (!errors.empty() && (n == 0 || errors.size() % n != 0 || errors.size() / n > kDepth))
     throw InputError("checkpoint: integrator.guess_errors holds " + std::to_string(errors.size()) +
                      " values, not up to " + std::to_string(kDepth) + " vectors of " + std::to_string(n));
+  restore(errors, n, errors.empty() ? 0 : errors.size() / n, dt);
+}
+
+void GuessErrorPredictor::restore(std::span<const double> errors, std::size_t n, std::size_t count, double dt) {
+  if (errors.size() != count * n || count > kDepth)
+    throw std::logic_error("GuessErrorPredictor::restore: " + std::to_string(errors.size()) + " values for " +
+                           std::to_string(count) + " vectors of " + std::to_string(n));
   clear();
-  for (std::size_t k = 0; !errors.empty() && k < errors.size() / n; ++k) record(dt, errors.subspan(k * n, n));
+  for (std::size_t k = 0; k < count; ++k) record(dt, errors.subspan(k * n, n));
 }
 
 }  // namespace immerse

@@ -48,8 +48,12 @@ class GuessErrorPredictor {
   /// The stored errors, oldest first, concatenated (for checkpoints), and the step they belong to.
   std::vector<double> errors() const;
   double dt() const { return dt_; }
+  /// The number of stored errors.
+  std::size_t count() const { return e_.size(); }
   /// Replaces the history by errors() of vectors of length n recorded with step dt.
   void restore(std::span<const double> errors, std::size_t n, double dt);
+  /// The same for `count` vectors, also of length 0 (a process of a distributed run that owns no membrane).
+  void restore(std::span<const double> errors, std::size_t n, std::size_t count, double dt);
 
  private:
   static constexpr std::size_t kDepth = kMaxTerms + kWindow + 1;  // one more to recompute the last prediction

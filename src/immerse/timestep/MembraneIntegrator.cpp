@@ -31,19 +31,28 @@ void MembraneIntegrator::set_history(std::vector<double> previous_positions, dou
   prev_dt_ = previous_dt;
 }
 
+void MembraneIntegrator::set_history(std::vector<double> previous_positions, double previous_dt,
+                                     std::span<const double> guess_errors, std::size_t guess_error_count) {
+  errors_.restore(guess_errors, previous_positions.size(), guess_error_count, previous_dt);
+  prev_X_ = std::move(previous_positions);
+  prev_dt_ = previous_dt;
+}
+
 void MembraneIntegrator::initial_guess(const ThetaResidual& g, SolverSettings::InitialGuess guess,
                                        std::span<double> X0) {
   g.initial_guess(prev_X_, prev_dt_, X0);
   extrapolated_.clear();
+  extrapolated_valid_ = false;
   // Only an extrapolation over a step equal to the last one is recorded: the errors scale with the steps.
   if (guess != SolverSettings::InitialGuess::Recurrence || prev_X_.size() != X0.size() || prev_dt_ != g.dt())
     return;
   extrapolated_.assign(X0.begin(), X0.end());
+  extrapolated_valid_ = true;
   errors_.predict(g.dt(), X0, g.op().membrane_offsets());
 }
 
 void MembraneIntegrator::remember(const CoupledOperator& op, double dt, std::span<const double> X) {
-  if (!extrapolated_.empty() && X.size() == extrapolated_.size()) {
+  if (extrapolated_valid_ && X.size() == extrapolated_.size()) {
     const long n = static_cast<long>(X.size());
     double* const e = extrapolated_.data();
 #pragma omp parallel for schedule(static) if (n >= kMinValuesForThreads)
@@ -53,6 +62,7 @@ void MembraneIntegrator::remember(const CoupledOperator& op, double dt, std::spa
     errors_.clear();
   }
   extrapolated_.clear();
+  extrapolated_valid_ = false;
   prev_X_.assign(op.positions().begin(), op.positions().end());
   prev_dt_ = dt;
 }
@@ -63,13 +73,24 @@ const std::vector<std::string>& integrator_names() {
 }
 
 std::unique_ptr<MembraneIntegrator> make_integrator(const std::string& name, const SolverSettings& settings) {
+  return make_integrator(name, settings, PETSC_COMM_SELF);
+}
+
+std::unique_ptr<MembraneIntegrator> make_integrator(const std::string& name, const SolverSettings& settings,
+                                                    MPI_Comm comm) {
   settings.validate();
   if (name == "euler") return std::make_unique<ForwardEuler>();
   if (name == "rk2") return std::make_unique<MidpointRK2>();
-  if (name == "jfnk") return std::make_unique<SnesIntegrator>(SnesIntegrator::Method::NewtonKrylov, settings);
-  if (name == "lbfgs") return std::make_unique<SnesIntegrator>(SnesIntegrator::Method::LimitedMemoryBFGS, settings);
-  if (name == "anderson") return std::make_unique<SnesIntegrator>(SnesIntegrator::Method::Anderson, settings);
-  if (name == "bfgs") return std::make_unique<DenseBfgs>(settings);
+  if (name == "jfnk") return std::make_unique<SnesIntegrator>(SnesIntegrator::Method::NewtonKrylov, settings, comm);
+  if (name == "lbfgs")
+    return std::make_unique<SnesIntegrator>(SnesIntegrator::Method::LimitedMemoryBFGS, settings, comm);
+  if (name == "anderson") return std::make_unique<SnesIntegrator>(SnesIntegrator::Method::Anderson, settings, comm);
+  if (name == "bfgs") {
+    if (comm != PETSC_COMM_SELF)
+      throw InputError("time.scheme = \"bfgs\": the dense quasi-Newton matrix of eq. (35) is not distributed (use "
+                       "\"jfnk\", \"anderson\" or \"lbfgs\", or run in one process)");
+    return std::make_unique<DenseBfgs>(settings);
+  }
   throw InputError("time.scheme = '" + name + "': must be one of euler, rk2, jfnk, bfgs, lbfgs, anderson");
 }
 

@@ -1,5 +1,7 @@
 #pragma once
 // Advancing the membrane (paper §2.4): the schemes share this interface.
+#include <mpi.h>
+
 #include <memory>
 #include <span>
 #include <string>
@@ -48,6 +50,10 @@ class MembraneIntegrator {
   const GuessErrorPredictor& guess_errors() const { return errors_; }
   void set_history(std::vector<double> previous_positions, double previous_dt,
                    std::span<const double> guess_errors = {});
+  /// The same with the number of stored guess errors given, which also holds for vectors of length 0 (a process of
+  /// a distributed run owning no membrane, whose history DistributedSimulation re-orders after a migration).
+  void set_history(std::vector<double> previous_positions, double previous_dt, std::span<const double> guess_errors,
+                   std::size_t guess_error_count);
 
  protected:
   /// X^(0) of the implicit schemes: the linear extrapolation (ThetaResidual::initial_guess), plus the error
@@ -60,7 +66,8 @@ class MembraneIntegrator {
  private:
   std::vector<double> prev_X_;
   double prev_dt_ = 0;
-  std::vector<double> extrapolated_;  // this step's linear extrapolation; empty when X^(0) was not one
+  std::vector<double> extrapolated_;  // this step's linear extrapolation, when extrapolated_valid_
+  bool extrapolated_valid_ = false;   // X^(0) was the extrapolation (a flag: there may be no unknowns)
   GuessErrorPredictor errors_;
 };
 
@@ -68,6 +75,12 @@ class MembraneIntegrator {
 /// "lbfgs" (limited-memory quasi-Newton), "anderson" (Anderson acceleration of the same implicit update).
 /// Unknown names throw InputError.
 std::unique_ptr<MembraneIntegrator> make_integrator(const std::string& name, const SolverSettings& settings);
+/// The same for unknowns shared by the processes of `comm` (each passing the operator of its share): the implicit
+/// schemes "jfnk", "lbfgs" and "anderson" on PETSc MPI vectors (SnesIntegrator.hpp); the explicit ones, which combine
+/// the unknowns one by one, unchanged. "bfgs" (a dense matrix over all unknowns) is an InputError unless `comm` is
+/// PETSC_COMM_SELF. Collective.
+std::unique_ptr<MembraneIntegrator> make_integrator(const std::string& name, const SolverSettings& settings,
+                                                    MPI_Comm comm);
 
 /// The accepted names, for error messages and documentation.
 const std::vector<std::string>& integrator_names();

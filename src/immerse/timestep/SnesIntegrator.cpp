@@ -23,7 +23,8 @@ constexpr double kStallFactor = 0.5;
 
 }  // namespace
 
-SnesIntegrator::SnesIntegrator(Method method, const SolverSettings& settings) : method_(method), settings_(settings) {
+SnesIntegrator::SnesIntegrator(Method method, const SolverSettings& settings, MPI_Comm comm)
+    : method_(method), settings_(settings), comm_(comm), distributed_(comm != PETSC_COMM_SELF) {
   settings_.validate();
   if (const char* env = std::getenv("PETSC_OPTIONS")) environment_options_ = env;
   IMMERSE_PETSC(PetscOptionsCreate(&options_));
@@ -124,9 +125,12 @@ void SnesIntegrator::destroy() {
 void SnesIntegrator::setup(std::size_t n) {
   n_ = n;
   const auto N = static_cast<PetscInt>(n);
-  IMMERSE_PETSC(VecCreateSeq(PETSC_COMM_SELF, N, &x_));
+  if (distributed_)
+    IMMERSE_PETSC(VecCreateMPI(comm_, N, PETSC_DETERMINE, &x_));  // the local part: the owned membranes' unknowns
+  else
+    IMMERSE_PETSC(VecCreateSeq(PETSC_COMM_SELF, N, &x_));
   IMMERSE_PETSC(VecDuplicate(x_, &r_));
-  IMMERSE_PETSC(SNESCreate(PETSC_COMM_SELF, &snes_));
+  IMMERSE_PETSC(SNESCreate(comm_, &snes_));
   IMMERSE_PETSC(PetscObjectSetOptions(reinterpret_cast<PetscObject>(snes_), options_));
   IMMERSE_PETSC(SNESSetFunction(snes_, r_, &SnesIntegrator::form_function, this));
   IMMERSE_PETSC(SNESSetConvergenceTest(snes_, &SnesIntegrator::converged, this, nullptr));
@@ -207,12 +211,28 @@ PetscErrorCode SnesIntegrator::form_function(SNES, Vec x, Vec f, void* ctx) {
 #pragma omp parallel for schedule(static) if (n >= kMinValuesForThreads)
   for (long i = 0; i < n; ++i) X[i] = scale * xs[i];
   PetscCall(VecRestoreArrayRead(x, &xs));
+  // 0: evaluated; 1: a SimulationError; 2: another exception. Distributed, the largest over the processes.
+  int failure = 0;
   try {
     (*self->residual_)(self->X_, self->g_);
+  } catch (const SimulationError&) {
+    self->callback_error_ = std::current_exception();
+    failure = 1;
   } catch (...) {
     self->callback_error_ = std::current_exception();
-    return PETSC_ERR_USER;
+    failure = 2;
   }
+  if (self->distributed_) {
+    int anywhere = 0;
+    if (MPI_Allreduce(&failure, &anywhere, 1, MPI_INT, MPI_MAX, self->comm_) != MPI_SUCCESS) return PETSC_ERR_MPI;
+    if (anywhere > failure)
+      self->callback_error_ = anywhere == 1 ? std::make_exception_ptr(SimulationError(
+                                                  "the residual could not be evaluated on another process"))
+                                            : std::make_exception_ptr(std::runtime_error(
+                                                  "the residual could not be evaluated on another process"));
+    failure = anywhere;
+  }
+  if (failure != 0) return PETSC_ERR_USER;
   PetscCall(VecGetArray(f, &fs));
   const double* const g = self->g_.data();
 #pragma omp parallel for schedule(static) if (n >= kMinValuesForThreads)
@@ -254,6 +274,14 @@ PetscErrorCode SnesIntegrator::gmres_converged(KSP ksp, PetscInt it, PetscReal r
   return 0;
 }
 
+bool SnesIntegrator::any_process(bool flag) const {
+  if (!distributed_) return flag;
+  int mine = flag ? 1 : 0, any = 0;
+  if (MPI_Allreduce(&mine, &any, 1, MPI_INT, MPI_MAX, comm_) != MPI_SUCCESS)
+    throw std::runtime_error("MPI error in MPI_Allreduce");
+  return any != 0;
+}
+
 void SnesIntegrator::prepare(std::size_t unknowns) {
   if (!snes_) setup(unknowns);
 }
@@ -262,6 +290,8 @@ SolverStats SnesIntegrator::step(CoupledOperator& op, double dt) {
   // PETSc's L-BFGS keeps its secant pairs from one solve to the next; each step starts afresh from H_0 = I instead,
   // so that a step depends only on the state a checkpoint holds (bitwise restarts).
   if (method_ == Method::LimitedMemoryBFGS) destroy();
+  // Distributed: membranes that migrated at the last commit changed the local sizes; all processes start afresh.
+  if (distributed_ && snes_ && any_process(op.size() != n_)) destroy();
   if (!snes_) setup(op.size());
   if (op.size() != n_) throw std::logic_error("SnesIntegrator: the number of unknowns changed");
   SolverStats stats;
@@ -330,7 +360,7 @@ SolverStats SnesIntegrator::step(CoupledOperator& op, double dt) {
   for (std::size_t i = 0; i < n_; ++i) X_[i] = scale_ * xr[i];
   IMMERSE_PETSC(VecRestoreArrayRead(x_, &xr));
   // The trial fluid state must be the one driven by the accepted positions.
-  if (!residual.trial_matches(X_)) residual(X_, g_);
+  if (any_process(!residual.trial_matches(X_))) residual(X_, g_);  // distributed: agreed, as it is collective
   remember(op, dt, X_);
   op.commit(X_, dt);
   stats.fluid_solves = op.fluid_solves() - solves0;

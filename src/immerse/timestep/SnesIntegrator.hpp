@@ -35,8 +35,20 @@
 // PETSC_OPTIONS (the former wins; both win over the settings); an option that no PETSc object of the solver, nor
 // PETSc itself, has used by the end of the first solve that iterates is an InputError (docs/user-guide.md, "PETSc
 // options").
+//
+// Distributed (a communicator other than PETSC_COMM_SELF, given at construction: make_integrator's overload with
+// one): each process passes the operator of the membranes it owns (DistributedOperator), whose size() is its share of
+// the unknowns. The vectors are PETSc MPI vectors with that local size, and SNES, KSP and MatMFFD live on the
+// communicator, so every norm and inner product is global and the mathematics, tolerances and the GMRES stall test
+// are those above. The residual callback evaluates g on the local part (the operator's trial_velocity is collective);
+// after each evaluation the processes agree on whether it failed anywhere, so that a SimulationError on one process
+// fails the attempt on all (the others report that it failed on another process). When the local number of unknowns
+// changed on any process (membranes migrated at the last commit), every process recreates the solver and its vectors
+// at the start of the step. The history of the initial guess is per process and per membrane (MembraneIntegrator);
+// DistributedSimulation moves it with the membranes. Every method is collective on the communicator.
 // Verified by: the studies oscillating_time_order, oscillating_stability, theta_ringing and quasi_newton_agreement,
-// and the tests Integrators.*, PetscOptionsTest.* and PetscOptionsBoth.*.
+// and the tests Integrators.*, PetscOptionsTest.* and PetscOptionsBoth.*; distributed: ParallelRun.* (the quick
+// red-cell channel with JFNK, Anderson and L-BFGS on 1 to 4 processes against the one-process run).
 #include <petscsnes.h>
 
 #include <exception>
@@ -50,7 +62,8 @@ namespace immerse {
 class SnesIntegrator final : public MembraneIntegrator {
  public:
   enum class Method { NewtonKrylov, LimitedMemoryBFGS, Anderson };
-  SnesIntegrator(Method method, const SolverSettings& settings);
+  /// `comm`: the processes that share the unknowns (PETSC_COMM_SELF: all of them here, sequential vectors).
+  SnesIntegrator(Method method, const SolverSettings& settings, MPI_Comm comm = PETSC_COMM_SELF);
   ~SnesIntegrator() override;
   SnesIntegrator(const SnesIntegrator&) = delete;
   SnesIntegrator& operator=(const SnesIntegrator&) = delete;
@@ -78,8 +91,13 @@ class SnesIntegrator final : public MembraneIntegrator {
   static PetscErrorCode gmres_converged(KSP ksp, PetscInt it, PetscReal rnorm, KSPConvergedReason* reason,
                                         void* ctx);
 
+  // Whether any process of comm_ reports `flag` (collective; false at once on PETSC_COMM_SELF).
+  bool any_process(bool flag) const;
+
   Method method_;
   SolverSettings settings_;
+  MPI_Comm comm_;
+  bool distributed_;  // comm_ is not PETSC_COMM_SELF: MPI vectors, agreement on sizes and failures
   std::string environment_options_;  // PETSC_OPTIONS
   PetscOptions options_ = nullptr;     // PETSC_OPTIONS, then solver.petsc_options, then the settings' options
   bool options_checked_ = false;
