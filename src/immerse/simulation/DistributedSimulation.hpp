@@ -13,8 +13,8 @@
 //
 // Refused with InputError, as not distributed yet: the implicit schemes (JFNK, Anderson, L-BFGS and BFGS need their
 // vectors distributed, PETSc parallel vectors), a membrane with viscosity_ratio ≠ 1 (the variable-viscosity fluid
-// step) and volume_correction = "normal_shift". Output, checkpoints and `immerse run` under mpirun are not part of
-// it: a caller gathers what it needs (gather_positions(), gather_fluid_state()).
+// step) and volume_correction = "normal_shift". Output and checkpoints are written by the caller (`immerse run` under
+// mpirun: app/DistributedRun.hpp) from the accessors below; restore() continues from a checkpoint.
 // Construction and advance() are collective over the communicator. No global state.
 // Verified by: the tests ParallelRun.* (tests/test_parallel_run.cpp, 1 to 4 processes: the quick red-cell channel
 // against the one-process Simulation within 1e-10, repeated bitwise, the refusals).
@@ -26,6 +26,7 @@
 #include "immerse/fluid/FluidState.hpp"
 #include "immerse/fluid/SlabNavierStokesSolver.hpp"
 #include "immerse/grid/Grid.hpp"
+#include "immerse/io/Checkpoint.hpp"
 #include "immerse/io/Config.hpp"
 #include "immerse/parallel/Communicator.hpp"
 #include "immerse/simulation/DistributedOperator.hpp"
@@ -59,6 +60,20 @@ class DistributedSimulation {
   std::vector<std::vector<Vec3>> gather_positions() const { return op_->ownership().gather_positions(); }
   /// The whole-grid fluid state, on every process. Collective.
   FluidState gather_fluid_state() const { return fluid_.gather(op_->fluid_state()); }
+
+  /// What output and checkpoints read: the resolved configuration, the slab fluid solver (its decomposition), the
+  /// membranes of the run (meshes, force objects, reference positions; all of them on every process) and the
+  /// integrator (its history, of the owned nodes).
+  const io::Config& config() const { return config_; }
+  const SlabNavierStokesSolver& fluid() const { return fluid_; }
+  const MembraneSet& membranes() const { return membranes_; }
+  const MembraneIntegrator& integrator() const { return *integrator_; }
+
+  /// Continues from a checkpoint of the same configuration written by any number of processes (or by Simulation):
+  /// every process passes the whole checkpoint; the fluid is cut into this run's slabs and the membranes are owned
+  /// by the processes holding their centroids. The integrator history (previous positions and guess errors, per node
+  /// in global membrane order) is taken for the owned nodes. InputError as Simulation::restore. Collective.
+  void restore(const io::Checkpoint& ck);
 
  private:
   void check_stability() const;
