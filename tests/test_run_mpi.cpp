@@ -1,0 +1,221 @@
+// `immerse run` under mpiexec (DistributedRun): the quick red-cell channel with midpoint RK2 written on 2 processes,
+// continued on 3 and in one process, against the uninterrupted one-process run; repeated runs bitwise; bad input on 3
+// processes; the ParaView frames written together by the processes.
+#include <gtest/gtest.h>
+#include <spawn.h>
+#include <sys/wait.h>
+
+#include <algorithm>
+#include <cmath>
+#include <regex>
+
+#include "immerse/io/Checkpoint.hpp"
+#include "immerse/io/Hdf5.hpp"
+#include "test_run_support.hpp"
+
+namespace immerse::testing {
+namespace {
+
+/// `mpiexec -n NP immerse ARGS...` to its end, with the environment OpenMPI needs to start as root without a remote
+/// launcher; -q leaves the standard error to the program.
+RunResult run_mpi(int np, const std::vector<std::string>& args, const fs::path& log_prefix) {
+  std::vector<std::string> argv_s{IMMERSE_MPIEXEC, "-q", "-n", std::to_string(np), "--oversubscribe",
+                                  immerse_program().string()};
+  argv_s.insert(argv_s.end(), args.begin(), args.end());
+  std::vector<char*> argv;
+  for (auto& a : argv_s) argv.push_back(a.data());
+  argv.push_back(nullptr);
+  std::vector<std::string> env_s{"OMPI_ALLOW_RUN_AS_ROOT=1", "OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1",
+                                 "OMPI_MCA_plm=isolated", "OMPI_MCA_btl_vader_single_copy_mechanism=none",
+                                 "OMP_NUM_THREADS=1", "ASAN_OPTIONS=detect_leaks=0"};
+  for (char** e = environ; *e; ++e) {
+    const std::string v = *e;
+    if (std::none_of(env_s.begin(), env_s.end(), [&](const std::string& s) {
+          return v.rfind(s.substr(0, s.find('=') + 1), 0) == 0;
+        }))
+      env_s.push_back(v);
+  }
+  std::vector<char*> envp;
+  for (auto& v : env_s) envp.push_back(v.data());
+  envp.push_back(nullptr);
+  const std::string out = log_prefix.string() + ".stdout", err = log_prefix.string() + ".stderr";
+  posix_spawn_file_actions_t actions;
+  posix_spawn_file_actions_init(&actions);
+  posix_spawn_file_actions_addopen(&actions, STDIN_FILENO, "/dev/null", O_RDONLY, 0);
+  posix_spawn_file_actions_addopen(&actions, STDOUT_FILENO, out.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+  posix_spawn_file_actions_addopen(&actions, STDERR_FILENO, err.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+  pid_t pid = -1;
+  const int rc = posix_spawn(&pid, argv[0], &actions, nullptr, argv.data(), envp.data());
+  posix_spawn_file_actions_destroy(&actions);
+  if (rc != 0) throw std::runtime_error("cannot start " + argv_s[0]);
+  int st = 0;
+  waitpid(pid, &st, 0);
+  return {WIFEXITED(st) ? WEXITSTATUS(st) : 128 + WTERMSIG(st), read_text(out), read_text(err)};
+}
+
+// The quick channel with midpoint RK2 at dt = 2e-5 s (ParallelRun's step), a frame and a checkpoint every 3 steps.
+std::vector<std::string> channel_args(const fs::path& out, int steps, const fs::path& restart = {}) {
+  return run_args(scenario_file("rbc_channel_quick.toml"), out,
+                  {"time.scheme=rk2", "time.dt=2e-5", "time.end=" + std::to_string(2e-5 * steps),
+                   "output.fields_every=3", "output.checkpoint_every=3"},
+                  restart);
+}
+
+std::vector<double> positions(const io::Checkpoint& ck) {
+  std::vector<double> all;
+  for (int m = 0; ck.has("membrane[" + std::to_string(m) + "].positions"); ++m) {
+    const auto& a = ck.array("membrane[" + std::to_string(m) + "].positions");
+    all.insert(all.end(), a.begin(), a.end());
+  }
+  return all;
+}
+
+/// max |a - b| / max |b|.
+double relative_difference(const std::vector<double>& a, const std::vector<double>& b) {
+  EXPECT_EQ(a.size(), b.size());
+  double d = 0, scale = 0;
+  for (std::size_t i = 0; i < std::min(a.size(), b.size()); ++i) {
+    d = std::max(d, std::abs(a[i] - b[i]));
+    scale = std::max(scale, std::abs(b[i]));
+  }
+  return d / scale;
+}
+
+std::vector<std::string> entry_names(const io::Checkpoint& ck, const io::Checkpoint& other) {
+  std::vector<std::string> missing;
+  for (const char* name :
+       {"config", "step", "fluid.u0", "fluid.u1", "fluid.u2", "fluid.adv0", "fluid.adv1", "fluid.adv2", "fluid.p",
+        "fluid.p_prev", "fluid.dt_prev", "fluid.dt_prev2", "fluid.step", "fluid.time", "membrane[0].positions",
+        "membrane[31].reference", "integrator.previous_positions", "integrator.previous_dt",
+        "integrator.guess_errors", "stepper.dt", "stepper.successes"})
+    if (!ck.has(name) || !other.has(name)) missing.push_back(name);
+  return missing;
+}
+
+TEST(RunMpi, CheckpointOfTwoProcessesContinuesOnThreeAndInOneProcessAsTheUninterruptedRun) {
+  ScratchDir dir("run_mpi");
+  const auto one = run_mpi(1, channel_args(dir / "one", 6), dir / "one");
+  ASSERT_EQ(one.status, 0) << one.err;
+  const auto two = run_mpi(2, channel_args(dir / "two", 3), dir / "two");
+  ASSERT_EQ(two.status, 0) << two.err;
+  EXPECT_NE(two.out.find("distributed over 2 MPI processes"), std::string::npos) << two.out;
+  const auto three = run_mpi(3, channel_args(dir / "three", 6, dir / "two" / "checkpoint.h5"), dir / "three");
+  ASSERT_EQ(three.status, 0) << three.err;
+  EXPECT_EQ(three.err, "");
+  const auto serial = run_mpi(1, channel_args(dir / "serial", 6, dir / "two" / "checkpoint.h5"), dir / "serial");
+  ASSERT_EQ(serial.status, 0) << serial.err;
+
+  const io::Checkpoint reference = io::Checkpoint::read(dir / "one" / "checkpoint.h5");
+  const io::Checkpoint half = io::Checkpoint::read(dir / "two" / "checkpoint.h5");
+  const io::Checkpoint continued = io::Checkpoint::read(dir / "three" / "checkpoint.h5");
+  const io::Checkpoint continued_serially = io::Checkpoint::read(dir / "serial" / "checkpoint.h5");
+  EXPECT_EQ(entry_names(half, reference), std::vector<std::string>{});
+  EXPECT_EQ(half.get_int("step"), 3);
+  EXPECT_EQ(reference.get_int("step"), 6);
+  EXPECT_EQ(continued.get_int("step"), 6);
+  EXPECT_EQ(continued_serially.get_int("step"), 6);
+  EXPECT_DOUBLE_EQ(continued.get_double("fluid.time"), reference.get_double("fluid.time"));
+  // The membranes moved by about 4e-8 m in 6 steps: 1e-10 of the largest coordinate (4.8e-5 m) is far below that.
+  const auto X = positions(reference);
+  ASSERT_EQ(X.size(), 32u * 642u * 3u);
+  EXPECT_LT(relative_difference(positions(continued), X), 1e-10);
+  EXPECT_LT(relative_difference(positions(continued_serially), X), 1e-10);
+  EXPECT_GT(relative_difference(positions(half), X), 1e-6);  // the cells moved between steps 3 and 6
+  for (const char* u : {"fluid.u0", "fluid.u1", "fluid.u2"})
+    EXPECT_LT(relative_difference(continued.array(u), reference.array(u)), 1e-10) << u;
+  // The distributed diagnostics keep the one-process columns.
+  const std::string header_one = read_text(dir / "one" / "diagnostics.csv").substr(0, 200);
+  const std::string header_two = read_text(dir / "two" / "diagnostics.csv").substr(0, 200);
+  EXPECT_EQ(header_one.substr(0, header_one.find('\n')), header_two.substr(0, header_two.find('\n')));
+}
+
+TEST(RunMpi, TwoProcessRunsGiveBitwiseTheSameCheckpoint) {
+  ScratchDir dir("run_mpi");
+  const auto a = run_mpi(2, channel_args(dir / "a", 3), dir / "a");
+  const auto b = run_mpi(2, channel_args(dir / "b", 3), dir / "b");
+  ASSERT_EQ(a.status, 0) << a.err;
+  ASSERT_EQ(b.status, 0) << b.err;
+  const io::Checkpoint ca = io::Checkpoint::read(dir / "a" / "checkpoint.h5");
+  const io::Checkpoint cb = io::Checkpoint::read(dir / "b" / "checkpoint.h5");
+  EXPECT_TRUE(ca == cb);
+  EXPECT_EQ(ca.checksum(), cb.checksum());
+  EXPECT_EQ(ca.get_int("step"), 3);
+}
+
+/// Exactly one line on the standard error, the error line, exit status 2 and no output folder.
+void expect_refused(const RunResult& r, const fs::path& out, const std::string& text) {
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+  EXPECT_EQ(r.err.rfind("immerse: error: ", 0), 0u) << r.err;
+  EXPECT_NE(r.err.find(text), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(out));
+}
+
+TEST(RunMpi, BadInputOnThreeProcessesIsOneLineAndWritesNothing) {
+  ScratchDir dir("run_mpi");
+  auto args = channel_args(dir / "bad_key", 3);
+  args.insert(args.end(), {"--set", "time.bogus=1"});
+  expect_refused(run_mpi(3, args, dir / "bad_key"), dir / "bad_key", "time.bogus");
+  // 24 cells between z walls: at most 2 processes leave two planes to the last one when there are only 4.
+  args = channel_args(dir / "planes", 3);
+  args.insert(args.end(), {"--set", "grid.nz=4"});
+  expect_refused(run_mpi(3, args, dir / "planes"), dir / "planes", "grid.nz = 4: 3 processes");
+  args = channel_args(dir / "implicit", 3);
+  args.insert(args.end(), {"--set", "time.scheme=jfnk"});
+  expect_refused(run_mpi(3, args, dir / "implicit"), dir / "implicit", "time.scheme");
+  args = run_args(scenario_file("rbc_stretch.toml"), dir / "kind", {"time.scheme=rk2"});
+  expect_refused(run_mpi(3, args, dir / "kind"), dir / "kind", "scenario.kind = \"rbc_stretch\"");
+  // A checkpoint of another grid (the same channel at twice the resolution).
+  ASSERT_EQ(run_mpi(2, channel_args(dir / "two", 3), dir / "two").status, 0);
+  args = channel_args(dir / "other_grid", 6, dir / "two" / "checkpoint.h5");
+  args.insert(args.end(), {"--set", "grid.nx=96", "--set", "grid.ny=192", "--set", "grid.nz=48"});
+  expect_refused(run_mpi(3, args, dir / "other_grid"), dir / "other_grid", "grid.nx = 96: the checkpoint");
+  // The folder of another run.
+  const auto again = run_mpi(3, channel_args(dir / "two", 3), dir / "again");
+  EXPECT_EQ(again.status, 2);
+  EXPECT_EQ(std::count(again.err.begin(), again.err.end(), '\n'), 1) << again.err;
+  EXPECT_NE(again.err.find("holds another run"), std::string::npos) << again.err;
+}
+
+TEST(RunMpi, FramesWrittenTogetherHoldTheDatasetsTheXdmfNames) {
+  ScratchDir dir("run_mpi");
+  const auto r = run_mpi(3, channel_args(dir / "run", 3), dir / "run");
+  ASSERT_EQ(r.status, 0) << r.err;
+  for (const char* series : {"membranes.xdmf", "fluid.xdmf"}) {
+    const std::string xdmf = read_text(dir / "run" / series);
+    const std::regex item(R"re(<DataItem Dimensions="([0-9 ]+)"[^>]*Format="HDF">([^:<]+):([^<]+)</DataItem>)re");
+    int items = 0;
+    for (auto it = std::sregex_iterator(xdmf.begin(), xdmf.end(), item); it != std::sregex_iterator(); ++it, ++items) {
+      std::vector<hsize_t> expected;
+      std::istringstream dims((*it)[1].str());
+      for (hsize_t d; dims >> d;) expected.push_back(d);
+      io::hdf5::Quiet quiet;
+      io::hdf5::Handle file = io::hdf5::open_file_readonly(dir / "run" / (*it)[2].str());
+      ASSERT_TRUE(file.valid()) << (*it)[2].str();
+      std::vector<hsize_t> found;
+      EXPECT_TRUE(io::hdf5::dataset_dims(file.get(), (*it)[3].str(), found)) << (*it)[3].str();
+      EXPECT_EQ(found, expected) << (*it)[2].str() << ":" << (*it)[3].str();
+    }
+    EXPECT_EQ(items, series == std::string("fluid.xdmf") ? 2 * 3 : 2 * 8) << series;  // frames 0 and 1 (step 3)
+  }
+  // Frame 1 is step 3: its nodes are the checkpoint's positions, bitwise; its pressure the checkpoint's.
+  const io::Checkpoint ck = io::Checkpoint::read(dir / "run" / "checkpoint.h5");
+  io::hdf5::Handle file = io::hdf5::open_file_readonly(dir / "run" / "fields_000001.h5");
+  std::vector<double> nodes, pressure;
+  std::vector<hsize_t> dims;
+  ASSERT_TRUE(io::hdf5::read_doubles(file.get(), "membranes/nodes", nodes, dims));
+  EXPECT_EQ(nodes, positions(ck));
+  ASSERT_TRUE(io::hdf5::read_doubles(file.get(), "fluid/pressure", pressure, dims));
+  EXPECT_EQ(pressure, ck.array("fluid.p"));
+  std::vector<std::int64_t> offsets;
+  ASSERT_TRUE(io::hdf5::read_int64(file.get(), "membranes/node_offsets", offsets, dims));
+  ASSERT_EQ(offsets.size(), 33u);
+  EXPECT_EQ(offsets.back(), 32 * 642);
+  std::vector<std::int32_t> conn;
+  ASSERT_TRUE(io::hdf5::read_int32(file.get(), "membranes/connectivity", conn, dims));
+  EXPECT_EQ(*std::max_element(conn.begin(), conn.end()), 32 * 642 - 1);
+  EXPECT_EQ(*std::min_element(conn.begin(), conn.end()), 0);
+}
+
+}  // namespace
+}  // namespace immerse::testing
