@@ -16,9 +16,9 @@
 namespace immerse::testing {
 namespace {
 
-/// `mpiexec -n NP immerse ARGS...` to its end, with the environment OpenMPI needs to start as root without a remote
-/// launcher; -q leaves the standard error to the program.
-RunResult run_mpi(int np, const std::vector<std::string>& args, const fs::path& log_prefix) {
+/// Starts `mpiexec -n NP immerse ARGS...` with the environment OpenMPI needs to start as root without a remote
+/// launcher; -q leaves the standard error to the program. Returns the pid of mpiexec.
+pid_t start_mpi(int np, const std::vector<std::string>& args, const fs::path& log_prefix) {
   std::vector<std::string> argv_s{IMMERSE_MPIEXEC, "-q", "-n", std::to_string(np), "--oversubscribe",
                                   immerse_program().string()};
   argv_s.insert(argv_s.end(), args.begin(), args.end());
@@ -48,9 +48,34 @@ RunResult run_mpi(int np, const std::vector<std::string>& args, const fs::path& 
   const int rc = posix_spawn(&pid, argv[0], &actions, nullptr, argv.data(), envp.data());
   posix_spawn_file_actions_destroy(&actions);
   if (rc != 0) throw std::runtime_error("cannot start " + argv_s[0]);
+  return pid;
+}
+
+RunResult wait_mpi(pid_t pid, const fs::path& log_prefix) {
   int st = 0;
   waitpid(pid, &st, 0);
-  return {WIFEXITED(st) ? WEXITSTATUS(st) : 128 + WTERMSIG(st), read_text(out), read_text(err)};
+  return {WIFEXITED(st) ? WEXITSTATUS(st) : 128 + WTERMSIG(st), read_text(log_prefix.string() + ".stdout"),
+          read_text(log_prefix.string() + ".stderr")};
+}
+
+/// `mpiexec -n NP immerse ARGS...` to its end.
+RunResult run_mpi(int np, const std::vector<std::string>& args, const fs::path& log_prefix) {
+  return wait_mpi(start_mpi(np, args, log_prefix), log_prefix);
+}
+
+/// The processes whose parent is `parent` (the ranks started by mpiexec).
+std::vector<pid_t> children(pid_t parent) {
+  std::vector<pid_t> found;
+  for (const auto& e : fs::directory_iterator("/proc")) {
+    const std::string stat = read_text(e.path() / "stat");
+    const auto close = stat.rfind(')');
+    if (close == std::string::npos) continue;
+    std::istringstream rest(stat.substr(close + 2));
+    char state = 0;
+    pid_t ppid = 0;
+    if (rest >> state >> ppid && ppid == parent) found.push_back(std::stoi(e.path().filename().string()));
+  }
+  return found;
 }
 
 // The quick channel with midpoint RK2 at dt = 2e-5 s (ParallelRun's step), a frame and a checkpoint every 3 steps.
@@ -215,6 +240,41 @@ TEST(RunMpi, FramesWrittenTogetherHoldTheDatasetsTheXdmfNames) {
   ASSERT_TRUE(io::hdf5::read_int32(file.get(), "membranes/connectivity", conn, dims));
   EXPECT_EQ(*std::max_element(conn.begin(), conn.end()), 32 * 642 - 1);
   EXPECT_EQ(*std::min_element(conn.begin(), conn.end()), 0);
+}
+
+TEST(RunMpi, UnstableRunStopsEveryProcessWithStatus3AndItsLastState) {
+  ScratchDir dir("run_mpi");
+  auto args = channel_args(dir / "run", 6);
+  args.insert(args.end(), {"--set", "time.max_speed=3e-4"});  // the channel's flow reaches 3.6e-4 m/s in its centre
+  const auto r = run_mpi(3, args, dir / "run");
+  EXPECT_EQ(r.status, 3) << r.err;
+  EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+  EXPECT_EQ(r.err.rfind("immerse: run stopped: unstable at step 1, t = 2e-05: fluid velocity u_y", 0), 0u) << r.err;
+  // As in one process, the unstable state is saved for inspection.
+  EXPECT_EQ(io::Checkpoint::read(dir / "run" / "checkpoint.h5").get_int("step"), 1);
+}
+
+TEST(RunMpi, StopSignalToOneProcessStopsAllAfterTheSameStepWithACheckpoint) {
+  ScratchDir dir("run_mpi");
+  auto args = channel_args(dir / "run", 500);
+  const pid_t mpiexec = start_mpi(2, args, dir / "run");
+  // Once a few rows are written, a scheduler's SIGTERM reaches one of the processes.
+  for (int i = 0; i < 600; ++i) {
+    const std::string rows = read_text(dir / "run" / "diagnostics.csv");
+    if (std::count(rows.begin(), rows.end(), '\n') >= 4) break;
+    usleep(100000);
+  }
+  const auto ranks = children(mpiexec);
+  ASSERT_EQ(ranks.size(), 2u);
+  kill(ranks.back(), SIGTERM);
+  const auto r = wait_mpi(mpiexec, dir / "run");
+  EXPECT_EQ(r.status, 4) << r.err;
+  EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+  EXPECT_EQ(r.err.rfind("immerse: interrupted by signal 15 at step ", 0), 0u) << r.err;
+  const io::Checkpoint ck = io::Checkpoint::read(dir / "run" / "checkpoint.h5");
+  EXPECT_GE(ck.get_int("step"), 3);
+  EXPECT_LT(ck.get_int("step"), 500);
+  EXPECT_NE(r.err.find("at step " + std::to_string(ck.get_int("step")) + ","), std::string::npos) << r.err;
 }
 
 }  // namespace

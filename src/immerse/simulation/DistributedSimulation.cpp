@@ -7,6 +7,7 @@
 
 #include "immerse/core/Error.hpp"
 #include "immerse/coupling/DeltaKernel.hpp"
+#include "immerse/parallel/Agreement.hpp"
 #include "immerse/simulation/CheckpointEntries.hpp"
 #include "immerse/simulation/RunSetup.hpp"
 
@@ -95,15 +96,22 @@ void DistributedSimulation::check_stability() const {
   for (int d = 0; d < 3 && what.empty(); ++d)
     for (double v : f.u[d].values())
       if (!(std::abs(v) <= max_speed_)) {
-        what = "unstable at step " + std::to_string(step_) + ": fluid velocity u_" + "xyz"[d] +
-               " is not finite or exceeds time.max_speed (runaway)";
+        std::ostringstream s;
+        s.precision(10);
+        s << "unstable at step " << step_ << ", t = " << time() << ": fluid velocity u_" << "xyz"[d]
+          << " is not finite or exceeds time.max_speed (runaway)";
+        what = s.str();
         break;
       }
-  if (what.empty() && !std::ranges::all_of(f.p.values(), [](double v) { return std::isfinite(v); }))
-    what = "unstable at step " + std::to_string(step_) + ": fluid pressure is not finite";
+  if (what.empty() && !std::ranges::all_of(f.p.values(), [](double v) { return std::isfinite(v); })) {
+    std::ostringstream s;
+    s.precision(10);
+    s << "unstable at step " << step_ << ", t = " << time() << ": fluid pressure is not finite";
+    what = s.str();
+  }
   const Communicator& comm = fluid_.decomposition().communicator();
-  if (comm.sum(what.empty() ? 0.0 : 1.0) > 0)
-    throw SimulationError(what.empty() ? "unstable at step " + std::to_string(step_) + " on another process" : what);
+  // Every process stops with the message of the lowest-ranked process that found the run unstable.
+  if (const std::string first = first_error(comm, what); !first.empty()) throw SimulationError(first);
 }
 
 void DistributedSimulation::restore(const io::Checkpoint& ck) {
