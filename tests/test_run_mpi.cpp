@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <regex>
 
 #include "immerse/io/Checkpoint.hpp"
@@ -95,6 +96,18 @@ std::vector<double> positions(const io::Checkpoint& ck) {
   return all;
 }
 
+/// The cells of a CSV file of numbers and names, by row.
+std::vector<std::vector<std::string>> read_csv(const fs::path& path) {
+  std::vector<std::vector<std::string>> rows;
+  std::istringstream in(read_text(path));
+  for (std::string line; std::getline(in, line);) {
+    rows.emplace_back();
+    std::istringstream cells(line);
+    for (std::string cell; std::getline(cells, cell, ',');) rows.back().push_back(cell);
+  }
+  return rows;
+}
+
 /// max |a - b| / max |b|.
 double relative_difference(const std::vector<double>& a, const std::vector<double>& b) {
   EXPECT_EQ(a.size(), b.size());
@@ -148,10 +161,29 @@ TEST(RunMpi, CheckpointOfTwoProcessesContinuesOnThreeAndInOneProcessAsTheUninter
   EXPECT_GT(relative_difference(positions(half), X), 1e-6);  // the cells moved between steps 3 and 6
   for (const char* u : {"fluid.u0", "fluid.u1", "fluid.u2"})
     EXPECT_LT(relative_difference(continued.array(u), reference.array(u)), 1e-10) << u;
-  // The distributed diagnostics keep the one-process columns.
-  const std::string header_one = read_text(dir / "one" / "diagnostics.csv").substr(0, 200);
-  const std::string header_two = read_text(dir / "two" / "diagnostics.csv").substr(0, 200);
-  EXPECT_EQ(header_one.substr(0, header_one.find('\n')), header_two.substr(0, header_two.find('\n')));
+  std::printf("[RunMpi] step 6 after 2 + 3 processes, after 2 + 1 process, against one process: positions %.2g, %.2g, "
+              "u_y %.2g\n",
+              relative_difference(positions(continued), X), relative_difference(positions(continued_serially), X),
+              relative_difference(continued.array("fluid.u1"), reference.array("fluid.u1")));
+  // The distributed diagnostics have the one-process columns, and their row of step 3 the same values of what does
+  // not depend on round-off in the last digits of nearly vanishing numbers (theta of a flat cell, say).
+  const auto one_rows = read_csv(dir / "one" / "diagnostics.csv");
+  const auto two_rows = read_csv(dir / "two" / "diagnostics.csv");
+  ASSERT_EQ(one_rows.size(), 8u);  // header, steps 0 to 6
+  ASSERT_EQ(two_rows.size(), 5u);  // header, steps 0 to 3
+  EXPECT_EQ(one_rows[0], two_rows[0]);
+  int compared = 0;
+  for (std::size_t c = 0; c < one_rows[0].size(); ++c) {
+    const std::string& name = one_rows[0][c];
+    const auto ends_with = [&](const std::string& tail) { return name.ends_with(tail); };
+    if (!(name == "step" || name == "time" || name == "dt" || name == "fluid_solves" || name == "mean_velocity" ||
+          ends_with("volume") || ends_with("area") || ends_with("cx") || ends_with("cy") || ends_with("cz")))
+      continue;
+    const double a = std::stod(two_rows[4][c]), b = std::stod(one_rows[4][c]);
+    EXPECT_LE(std::abs(a - b), 1e-10 * std::abs(b)) << name;
+    ++compared;
+  }
+  EXPECT_EQ(compared, 4 + 5 * 32 + 1);
 }
 
 TEST(RunMpi, TwoProcessRunsGiveBitwiseTheSameCheckpoint) {
