@@ -60,7 +60,8 @@ void check_process_count(const io::Config& config, int processes) {
   for (int p = 1; p <= nz; ++p)
     if (fits(p)) most = p;
   throw InputError("grid.nz = " + std::to_string(nz) + ": " + std::to_string(processes) +
-                   " processes leave the last one without " + (need == 2 ? "two cell planes (walls along z)" : "a cell plane") +
+                   " processes leave the last one without " +
+                   (need == 2 ? "two cell planes (walls along z)" : "a cell plane") +
                    "; a run in slabs of z planes takes at most " + std::to_string(most) + " processes on this grid");
 }
 
@@ -114,7 +115,8 @@ io::ParallelCheckpoint checkpoint_of(const DistributedSimulation& sim) {
   const auto put_field = [&](const std::string& name, const Array3& local, Layout layout) {
     PlaneRange planes;
     const auto values = held_values(slabs, local, layout, planes);
-    const auto s = layout == Layout::Pressure ? sim.grid().cell_shape() : sim.grid().face_shape(static_cast<int>(layout));
+    const auto s =
+        layout == Layout::Pressure ? sim.grid().cell_shape() : sim.grid().face_shape(static_cast<int>(layout));
     const std::size_t plane = std::size_t(s[0]) * std::size_t(s[1]);
     ck.put_array(name, {std::size_t(s[2]), std::size_t(s[1]), std::size_t(s[0])},
                  {{planes.begin * plane, {values.begin(), values.end()}}});
@@ -154,8 +156,9 @@ io::ParallelCheckpoint checkpoint_of(const DistributedSimulation& sim) {
     for (int k = 0; k < vectors && local > 0; ++k)
       for (const OwnedMembrane& o : owned) {
         const std::size_t n = 3 * o.positions.size();
-        pieces.push_back({k * unknowns + 3 * layout.node[static_cast<std::size_t>(o.id)],
-                          {values.begin() + static_cast<std::ptrdiff_t>(at), values.begin() + static_cast<std::ptrdiff_t>(at + n)}});
+        pieces.push_back(
+            {k * unknowns + 3 * layout.node[static_cast<std::size_t>(o.id)],
+             {values.begin() + static_cast<std::ptrdiff_t>(at), values.begin() + static_cast<std::ptrdiff_t>(at + n)}});
         at += n;
       }
     ck.put_array(name, {static_cast<std::size_t>(vectors) * unknowns}, std::move(pieces));
@@ -173,7 +176,8 @@ io::ParallelCheckpoint checkpoint_of(const DistributedSimulation& sim) {
 /// membranes' nodes and triangles and its z planes of the fluid; returns the XDMF fragments. SimulationError on every
 /// process if the forces of a membrane cannot be evaluated. Collective.
 std::pair<std::string, std::string> write_frame(const DistributedSimulation& sim, const std::filesystem::path& dir,
-                                                int frame, const std::vector<std::pair<std::string, std::string>>& attributes,
+                                                int frame,
+                                                const std::vector<std::pair<std::string, std::string>>& attributes,
                                                 bool fluid_fields) {
   const SlabDecomposition& slabs = sim.fluid().decomposition();
   const Communicator& comm = slabs.communicator();
@@ -241,9 +245,10 @@ std::pair<std::string, std::string> write_frame(const DistributedSimulation& sim
       check(io::phdf5::write_int32(g.get(), "membrane_id", {nt}, triangle_rows, id.data()), "/membranes/membrane_id");
       std::vector<std::int64_t> node_offsets(layout.node.begin(), layout.node.end());
       const Rows all{0, node_offsets.size()};
-      check(io::phdf5::write_int64(g.get(), "node_offsets", {node_offsets.size()},
-                                   root ? std::span<const Rows>(&all, 1) : std::span<const Rows>(), node_offsets.data()),
-            "/membranes/node_offsets");
+      check(
+          io::phdf5::write_int64(g.get(), "node_offsets", {node_offsets.size()},
+                                 root ? std::span<const Rows>(&all, 1) : std::span<const Rows>(), node_offsets.data()),
+          "/membranes/node_offsets");
       check(io::phdf5::write_doubles(g.get(), "force", {nn, 3}, node_rows, F.data()), "/membranes/force");
       check(io::phdf5::write_doubles(g.get(), "velocity", {nn, 3}, node_rows, V.data()), "/membranes/velocity");
       check(io::phdf5::write_doubles(g.get(), "tension_1", {nn}, node_rows, tau1.data()), "/membranes/tension_1");
@@ -324,7 +329,8 @@ class RootOutput {
         first_frame_(in_place_ && settings.fields_every > 0 ? static_cast<int>(sim.step() / settings.fields_every) + 1
                                                             : 0),
         diagnostics_(sim.config(), sim.num_membranes(), scenario),
-        table_("diagnostics", diagnostics_.columns(), [step = sim.step()](long, double s) { return s <= double(step); }) {
+        table_("diagnostics", diagnostics_.columns(),
+               [step = sim.step()](long, double s) { return s <= double(step); }) {
     if (in_place_ && options.overwrite)
       throw InputError("--overwrite: would remove the run that --restart " + options.restart.string() +
                        " continues (leave out --overwrite to continue it in " + options.out.string() + ")");
@@ -349,8 +355,8 @@ class RootOutput {
   io::XdmfWriter& frames() { return *frames_; }
 
   /// The first files, as RunOutput::create (a failure puts the folder back as it was).
-  void create(const MeshCopies& copies, const io::Provenance& provenance, const DistributedSimulation& sim, int processes,
-              std::ostream& out) {
+  void create(const MeshCopies& copies, const io::Provenance& provenance, const DistributedSimulation& sim,
+              int processes, std::ostream& out) {
     folder_->keep_run_files();
     try {
       frames_.emplace(dir_, first_frame_);
@@ -541,7 +547,8 @@ class DistributedLoop {
     ++steps_;
     for (auto [s, act] : actions())
       if (s->due(sim_.step())) run_action(*s, act);
-    progress_.update(sim_.time(), sim_.step(), [] { return std::nan(""); }, steps_);
+    progress_.update(
+        sim_.time(), sim_.step(), [] { return std::nan(""); }, steps_);
     if (stop_signal()) status_ = 4;
   }
 
@@ -588,8 +595,8 @@ io::Provenance shared_provenance(const Communicator& comm, const RunOptions& opt
       options.command_line.empty() ? "immerse run " + options.file.string() : options.command_line,
       std::to_string(processes) + " MPI processes, each with the OpenMP threads OMP_NUM_THREADS gives it");
   if (!options.restart.empty())
-    p.restarted_from = options.restart.string() + " at step " + std::to_string(step) + ", t = " +
-                       io::format_number(time) + (in_place ? " (continued)" : " (branched)");
+    p.restarted_from = options.restart.string() + " at step " + std::to_string(step) +
+                       ", t = " + io::format_number(time) + (in_place ? " (continued)" : " (branched)");
   for (std::string* s : {&p.version, &p.commit, &p.command_line, &p.start_time, &p.host, &p.threads, &p.restarted_from})
     *s = broadcast_text(comm, *s);
   return p;

@@ -6,8 +6,8 @@
 // planes, the checkpoint of a restart) and builds the run; bad input ends every process with status 2, one line on
 // rank 0 and nothing written. Rank 0 then takes the output folder with the rules of the one-process run (RunOutput:
 // lock, refusal of another run's folder without --overwrite, rows kept when continuing in place) and tells the others;
-// it writes diagnostics.csv, its table of columns, config.resolved.toml (with the provenance), the copies of mesh files,
-// the XDMF series and the log. Frames (fields_NNNNNN.h5) and checkpoints are written by all processes together
+// it writes diagnostics.csv, its table of columns, config.resolved.toml (with the provenance), the copies of mesh
+// files, the XDMF series and the log. Frames (fields_NNNNNN.h5) and checkpoints are written by all processes together
 // (parallel HDF5, ParallelCheckpoint), each its own z planes and membranes; the file layouts are those of the
 // one-process run, so its readers (Checkpoint::read, the XDMF series, the Python package) read them, and a checkpoint
 // restarts on any number of processes or in one.

@@ -33,7 +33,8 @@ void ParallelCheckpoint::put_array(const std::string& name, std::vector<std::siz
   std::erase_if(pieces, [](const Piece& p) { return p.values.empty(); });
   std::ranges::sort(pieces, {}, &Piece::offset);
   for (const Piece& p : pieces)
-    if (p.offset + p.values.size() > a.size) throw std::logic_error("checkpoint: a piece of '" + name + "' is outside it");
+    if (p.offset + p.values.size() > a.size)
+      throw std::logic_error("checkpoint: a piece of '" + name + "' is outside it");
   a.pieces = std::move(pieces);
   arrays_[name] = std::move(a);
 }
@@ -56,7 +57,8 @@ std::uint64_t ParallelCheckpoint::checksum() const {
   std::vector<double> mine;
   std::size_t number = 0;
   for (const auto& [name, a] : arrays_) {
-    for (const Piece& p : a.pieces) mine.insert(mine.end(), {double(number), double(p.offset), double(p.values.size()), double(rank)});
+    for (const Piece& p : a.pieces)
+      mine.insert(mine.end(), {double(number), double(p.offset), double(p.values.size()), double(rank)});
     ++number;
   }
   const std::vector<double> all = comm_.all_gather(mine);

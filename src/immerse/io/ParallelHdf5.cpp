@@ -18,9 +18,9 @@ hdf5::Handle create_file(const std::string& path, MPI_Comm comm) {
 
 bool write_rows(hid_t loc, const std::string& name, hid_t file_type, hid_t mem_type, const std::vector<hsize_t>& dims,
                 std::span<const Rows> rows, const void* data) {
-  hdf5::Handle space(dims.empty() ? H5Screate(H5S_SCALAR)
-                                  : H5Screate_simple(static_cast<int>(dims.size()), dims.data(), nullptr),
-                     H5Sclose);
+  hdf5::Handle space(
+      dims.empty() ? H5Screate(H5S_SCALAR) : H5Screate_simple(static_cast<int>(dims.size()), dims.data(), nullptr),
+      H5Sclose);
   if (!space.valid()) return false;
   hdf5::Handle set(H5Dcreate2(loc, name.c_str(), file_type, space.get(), H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT),
                    H5Dclose);
@@ -78,8 +78,8 @@ bool write_string(hid_t loc, const std::string& name, const std::string& value, 
     return false;
   const std::string padded = value.empty() ? std::string(1, '\0') : value;
   const Rows all{0, 1};
-  return write_rows(loc, name, type.get(), type.get(), {}, writer ? std::span<const Rows>(&all, 1)
-                                                                  : std::span<const Rows>(), padded.data());
+  return write_rows(loc, name, type.get(), type.get(), {},
+                    writer ? std::span<const Rows>(&all, 1) : std::span<const Rows>(), padded.data());
 }
 
 void write_file_atomically(const std::filesystem::path& path, const Communicator& comm,

@@ -226,7 +226,8 @@ std::string XdmfWriter::fluid_fragment(const std::string& file, int frame, doubl
          format_number(h) + " " + format_number(h) + " " + format_number(h) + "</DataItem>\n      </Geometry>\n" +
          attribute("velocity", "Vector", "Node", data_item(file, "/fluid/velocity", vdims, false)) +
          attribute("pressure", "Scalar", "Node", data_item(file, "/fluid/pressure", sdims, false)) +
-         attribute("vorticity_magnitude", "Scalar", "Node", data_item(file, "/fluid/vorticity_magnitude", sdims, false)) +
+         attribute("vorticity_magnitude", "Scalar", "Node",
+                   data_item(file, "/fluid/vorticity_magnitude", sdims, false)) +
          "    </Grid>\n";
 }
 

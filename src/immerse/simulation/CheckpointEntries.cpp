@@ -30,7 +30,8 @@ void check_checkpoint_configuration(const io::Config& config, const io::Checkpoi
     for (std::size_t i = 0; i < config.count(t.name); ++i)
       for (const auto& k : config.entry(t.name, i).schema().keys()) {
         if (may_change(k.key)) continue;
-        const std::string was = theirs.entry(t.name, i).value_text(k.key), is = config.entry(t.name, i).value_text(k.key);
+        const std::string was = theirs.entry(t.name, i).value_text(k.key),
+                          is = config.entry(t.name, i).value_text(k.key);
         if (was != is) differ(t.name + "[" + std::to_string(i) + "]." + k.key, was, is);
       }
   }
@@ -57,10 +58,11 @@ double CheckpointEntries::time_value(const std::string& name) const {
 const std::vector<double>& CheckpointEntries::array(const std::string& name, std::size_t size) const {
   const auto& values = ck_.array(name);
   if (values.size() != size)
-    ck_.invalid(name, "has " + std::to_string(values.size()) + " values, this configuration needs " +
-                          std::to_string(size));
+    ck_.invalid(name,
+                "has " + std::to_string(values.size()) + " values, this configuration needs " + std::to_string(size));
   for (std::size_t i = 0; i < values.size(); ++i)
-    if (!std::isfinite(values[i])) ck_.invalid(name, "has a value that is not finite (index " + std::to_string(i) + ")");
+    if (!std::isfinite(values[i]))
+      ck_.invalid(name, "has a value that is not finite (index " + std::to_string(i) + ")");
   return values;
 }
 
