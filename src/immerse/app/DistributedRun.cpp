@@ -491,7 +491,7 @@ class DistributedLoop {
         break;
       case Action::Fields: {
         const auto [mx, fx] = write_frame(sim_, dir_, frame_, provenance_.attributes(), settings_.fluid_fields);
-        if (root_) root_->frames().append_frame(mx, fx);
+        on_root([&] { root_->frames().append_frame(mx, fx); });
         ++frame_;
         break;
       }
@@ -511,20 +511,33 @@ class DistributedLoop {
     if (last_.step != sim_.step()) return;
     const auto X = sim_.gather_positions();
     const double mean_velocity = channel_ ? mean_velocity_y(sim_) : 0;
-    if (!root_) return;
-    std::vector<double> row{double(last_.step), last_.time};
-    if (shear_rate_ > 0) row.push_back(shear_rate_ * last_.time);
-    row.insert(row.end(), {last_.dt, 0.0, 0.0, double(last_.fluid_solves), 0.0, last_.wall_seconds});
-    for (std::size_t m = 0; m < X.size(); ++m) {
-      const MembraneGeometry g = measure(sim_.membranes().meshes[m], X[m]);
-      const ShearPlaneProfile p = shear_plane_profile(sim_.membranes().meshes[m], X[m], g.centroid);
-      const auto a = semi_axes_along_xyz(g);
-      row.insert(row.end(), {g.volume, g.area, g.centroid.x, g.centroid.y, g.centroid.z, a[0], a[1], a[2], p.D_xz,
-                             inclination(g)});
-      scenario_.add_membrane_values(X[m], row);
-    }
-    if (channel_) row.push_back(mean_velocity);
-    root_->table().row(row);
+    on_root([&] {
+      std::vector<double> row{double(last_.step), last_.time};
+      if (shear_rate_ > 0) row.push_back(shear_rate_ * last_.time);
+      row.insert(row.end(), {last_.dt, 0.0, 0.0, double(last_.fluid_solves), 0.0, last_.wall_seconds});
+      for (std::size_t m = 0; m < X.size(); ++m) {
+        const MembraneGeometry g = measure(sim_.membranes().meshes[m], X[m]);
+        const ShearPlaneProfile p = shear_plane_profile(sim_.membranes().meshes[m], X[m], g.centroid);
+        const auto a = semi_axes_along_xyz(g);
+        row.insert(row.end(), {g.volume, g.area, g.centroid.x, g.centroid.y, g.centroid.z, a[0], a[1], a[2], p.D_xz,
+                               inclination(g)});
+        scenario_.add_membrane_values(X[m], row);
+      }
+      if (channel_) row.push_back(mean_velocity);
+      root_->table().row(row);
+    });
+  }
+
+  // Work of rank 0 alone (the CSV table, the XDMF series): a write that fails there stops every process.
+  template <class Work>
+  void on_root(Work&& work) {
+    std::string failed;
+    if (root_) try {
+        work();
+      } catch (const WriteError& e) {
+        failed = e.what();
+      }
+    if (const std::string first = first_error(comm_, failed); !first.empty()) throw WriteError(first);
   }
 
   void step_once() {
