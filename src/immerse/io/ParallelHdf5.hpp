@@ -4,6 +4,8 @@
 // planes of a fluid array, the nodes of the membranes it owns) with collective I/O. Metadata (groups, attributes)
 // is written by every process with the same values, as parallel HDF5 requires. Functions report failure through
 // their return value, as those of Hdf5.hpp.
+// Verified by: the tests RunMpi.* (tests/test_run_mpi.cpp: frames and checkpoints of 2 and 3 processes read back
+// with the one-process readers).
 #include <mpi.h>
 
 #include <filesystem>

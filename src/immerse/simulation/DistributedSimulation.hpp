@@ -17,7 +17,8 @@
 // mpirun: app/DistributedRun.hpp) from the accessors below; restore() continues from a checkpoint.
 // Construction and advance() are collective over the communicator. No global state.
 // Verified by: the tests ParallelRun.* (tests/test_parallel_run.cpp, 1 to 4 processes: the quick red-cell channel
-// against the one-process Simulation within 1e-10, repeated bitwise, the refusals).
+// against the one-process Simulation within 1e-10, repeated bitwise, the refusals); restore() by RunMpi.*
+// (tests/test_run_mpi.cpp: a checkpoint of 2 processes continued on 3).
 #include <memory>
 #include <vector>
 
