@@ -131,6 +131,7 @@ std::vector<std::string> entry_names(const io::Checkpoint& ck, const io::Checkpo
 }
 
 TEST(RunMpi, CheckpointOfTwoProcessesContinuesOnThreeAndInOneProcessAsTheUninterruptedRun) {
+  // 2 processes to step 3, then 3 processes (and one) to step 6, against one process to step 6.
   ScratchDir dir("run_mpi");
   const auto one = run_mpi(1, channel_args(dir / "one", 6), dir / "one");
   ASSERT_EQ(one.status, 0) << one.err;
@@ -161,6 +162,17 @@ TEST(RunMpi, CheckpointOfTwoProcessesContinuesOnThreeAndInOneProcessAsTheUninter
   EXPECT_GT(relative_difference(positions(half), X), 1e-6);  // the cells moved between steps 3 and 6
   for (const char* u : {"fluid.u0", "fluid.u1", "fluid.u2"})
     EXPECT_LT(relative_difference(continued.array(u), reference.array(u)), 1e-10) << u;
+  // The other way: the one-process checkpoint of step 6 continued on 2 processes and in one, to step 9.
+  const auto on_two = run_mpi(2, channel_args(dir / "on_two", 9, dir / "one" / "checkpoint.h5"), dir / "on_two");
+  ASSERT_EQ(on_two.status, 0) << on_two.err;
+  const auto on_one = run_mpi(1, channel_args(dir / "on_one", 9, dir / "one" / "checkpoint.h5"), dir / "on_one");
+  ASSERT_EQ(on_one.status, 0) << on_one.err;
+  const io::Checkpoint nine_two = io::Checkpoint::read(dir / "on_two" / "checkpoint.h5");
+  const io::Checkpoint nine_one = io::Checkpoint::read(dir / "on_one" / "checkpoint.h5");
+  EXPECT_EQ(nine_two.get_int("step"), 9);
+  EXPECT_LT(relative_difference(positions(nine_two), positions(nine_one)), 1e-10);
+  std::printf("[RunMpi] step 9 from the one-process checkpoint of step 6, 2 processes against one: positions %.2g\n",
+              relative_difference(positions(nine_two), positions(nine_one)));
   std::printf("[RunMpi] step 6 after 2 + 3 processes, after 2 + 1 process, against one process: positions %.2g, %.2g, "
               "u_y %.2g\n",
               relative_difference(positions(continued), X), relative_difference(positions(continued_serially), X),
