@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cmath>
 #include <iomanip>
+#include <limits>
 #include <memory>
 #include <optional>
 #include <ostream>
@@ -24,6 +25,7 @@
 #include "immerse/app/StopSignals.hpp"
 #include "immerse/core/Error.hpp"
 #include "immerse/core/ThreadGovernor.hpp"
+#include "immerse/coupling/NodeDiagnostics.hpp"
 #include "immerse/io/AtomicFile.hpp"
 #include "immerse/io/CellFields.hpp"
 #include "immerse/io/OutputFolder.hpp"
@@ -296,6 +298,20 @@ double mean_velocity_y(const DistributedSimulation& sim) {
   return sim.fluid().decomposition().communicator().sum(sum) / (double(s[0]) * s[1] * s[2]);
 }
 
+/// The closest approach of a node to a wall over all processes (not finite: no walls, or a node outside the box).
+/// Collective.
+double wall_distance(const DistributedSimulation& sim) {
+  const auto X = sim.op().positions();
+  double mine = std::numeric_limits<double>::infinity();
+  try {
+    mine = min_wall_distance(sim.grid(), {reinterpret_cast<const Vec3*>(X.data()), X.size() / 3});
+  } catch (const SimulationError&) {
+    mine = -1;  // a node outside the box: the next step reports it
+  }
+  const double all = min_over_processes(sim.fluid().decomposition().communicator(), mine);
+  return all < 0 ? std::numeric_limits<double>::quiet_NaN() : all;
+}
+
 bool same_folder(const std::filesystem::path& a, const std::filesystem::path& b) {
   std::error_code ec;
   return std::filesystem::equivalent(a.parent_path().empty() ? "." : a.parent_path(), b, ec) && !ec;
@@ -560,8 +576,9 @@ class DistributedLoop {
     ++steps_;
     for (auto [s, act] : actions())
       if (s->due(sim_.step())) run_action(*s, act);
+    const double wall = wall_distance(sim_);
     progress_.update(
-        sim_.time(), sim_.step(), [] { return std::nan(""); }, steps_);
+        sim_.time(), sim_.step(), [wall] { return wall; }, steps_);
     if (stop_signal()) status_ = 4;
   }
 
@@ -670,7 +687,11 @@ int run_distributed(const RunOptions& options, std::ostream& out, std::ostream& 
   // 3. The time loop, with its output on schedules.
   DistributedLoop loop(*sim, options, *settings, *scenario, output.get(), provenance, log, errors);
   const int status = loop.run();
-  log << "done: " << sim->step() << " steps, t = " << sim->time() << "\n";
+  log << "done: " << sim->step() << " steps, t = " << sim->time();
+  if (status == 0)
+    if (const double wall = wall_distance(*sim); std::isfinite(wall))
+      log << ", closest approach of a node to a wall " << wall;
+  log << "\n";
   if (loop.steps() > 0) {
     std::ostringstream took;
     took << std::fixed << std::setprecision(1) << "stepping took " << loop.stepping_seconds() << " s on " << processes

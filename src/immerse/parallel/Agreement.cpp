@@ -33,4 +33,10 @@ int max_over_processes(const Communicator& comm, int value) {
   return result;
 }
 
+double min_over_processes(const Communicator& comm, double value) {
+  double result = 0;
+  check(MPI_Allreduce(&value, &result, 1, MPI_DOUBLE, MPI_MIN, comm.comm()), "MPI_Allreduce");
+  return result;
+}
+
 }  // namespace immerse
