@@ -15,6 +15,8 @@
 // The time loop steps, writes on the schedules of RunOutput and stops, on every process together, when the run ends,
 // becomes unstable (status 3: the message on rank 0, the last state saved as in one process), a write fails (5) or
 // a process received SIGINT, SIGTERM, SIGHUP or SIGQUIT (4: agreed by a reduction after each step, then a checkpoint).
+// Verified by: the tests RunMpi.* (tests/test_run_mpi.cpp: `mpiexec -n N immerse run` on 1 to 3 processes) and
+// Python.OutputFiles (a 2-process run's files read by meshio and h5py, its frames against one process's).
 #include <iosfwd>
 
 #include "immerse/app/RunOptions.hpp"
