@@ -1,6 +1,7 @@
 """A run folder read by common Python tools without hand work: membranes.xdmf by meshio's XDMF time series reader
 (all membranes in one surface per frame, cell data membrane_id, the moving nodes as the field "position"),
-diagnostics.csv and its table of units by numpy. Run by CTest with /usr/bin/python3 (python3-meshio)."""
+diagnostics.csv and its table of units by numpy; the same files written by two MPI processes together. Run by CTest
+with /usr/bin/python3 (python3-meshio)."""
 import os
 import subprocess
 import tempfile
@@ -12,6 +13,10 @@ import meshio
 import numpy as np
 
 PROGRAM = os.environ["IMMERSE_PROGRAM"]
+MPIEXEC = os.environ["IMMERSE_MPIEXEC"]
+# What OpenMPI needs to start as root and without a remote launcher.
+MPI_ENV = dict(os.environ, OMP_NUM_THREADS="1", OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1",
+               OMPI_MCA_plm="isolated", OMPI_MCA_btl_vader_single_copy_mechanism="none")
 
 # Two spheres of radius 1 side by side in a periodic box (nondimensional units), one stretched along x.
 CONFIG = """
@@ -93,6 +98,43 @@ class OutputFiles(unittest.TestCase):
         unit = dict(zip(units["column"], units["unit"]))
         self.assertEqual((unit["time"], unit["m0_volume"], unit["m1_theta"]), ("s", "m^3", "rad"))
         np.testing.assert_allclose(rows["time"], [0.0, 0.02, 0.04, 0.06])
+
+
+class OutputFilesOverMpi(OutputFiles):
+    """The same run with midpoint RK2 (a distributed run takes the explicit schemes) on two MPI processes, whose
+    frames are written together with parallel HDF5: read by the same tools, and equal to the frames of one process."""
+
+    @classmethod
+    def setUpClass(cls):
+        cls.tmp = tempfile.TemporaryDirectory()
+        cls.dir = Path(cls.tmp.name)
+        (cls.dir / "two.toml").write_text(CONFIG)
+        cls.out = cls.dir / "out"
+        cls.serial = cls.dir / "serial"
+        for processes, out in ((2, cls.out), (1, cls.serial)):
+            subprocess.run([MPIEXEC, "-q", "-n", str(processes), "--oversubscribe", PROGRAM, "run",
+                            str(cls.dir / "two.toml"), "--out", str(out), "--set", "time.scheme=rk2"], check=True,
+                           stdout=subprocess.DEVNULL, env=MPI_ENV)
+
+    def test_frames_equal_those_of_one_process(self):
+        def datasets(f):
+            found = {}
+            f.visititems(lambda name, item: found.update({name: item[()]}) if isinstance(item, h5py.Dataset) else None)
+            return found
+
+        for k in range(4):
+            with h5py.File(self.out / f"fields_{k:06d}.h5", "r") as a, \
+                    h5py.File(self.serial / f"fields_{k:06d}.h5", "r") as b:
+                mine, theirs = datasets(a), datasets(b)
+                self.assertEqual(sorted(mine), sorted(theirs))
+                for name in theirs:
+                    self.assertEqual((mine[name].shape, mine[name].dtype), (theirs[name].shape, theirs[name].dtype))
+                    scale = max(np.abs(theirs[name]).max(), 1e-300)
+                    self.assertLess(np.abs(mine[name] - theirs[name]).max() / scale, 1e-10, name)
+                self.assertEqual(a.attrs["xdmf_membranes"], b.attrs["xdmf_membranes"])
+                self.assertEqual(a.attrs["xdmf_fluid"], b.attrs["xdmf_fluid"])
+        with h5py.File(self.out / "fields_000000.h5", "r") as a:
+            self.assertEqual(a.attrs["threads"], "2 MPI processes, each with the OpenMP threads OMP_NUM_THREADS gives it")
 
 
 if __name__ == "__main__":

@@ -17,17 +17,20 @@ Progress::Progress(std::ostream& out, double end, double log_seconds)
     : out_(out), end_(end), every_(log_seconds), tty_(isatty(STDOUT_FILENO)), t0_(clock::now()), last_(t0_) {}
 
 void Progress::update(const Simulation& sim, long steps_done) {
+  update(sim.time(), sim.step(), [&sim] { return sim.op().min_wall_distance(); }, steps_done);
+}
+
+void Progress::update(double time, long step, const std::function<double()>& wall_distance, long steps_done) {
   const auto now = clock::now();
   const double elapsed = std::chrono::duration<double>(now - t0_).count();
   if (!tty_ && std::chrono::duration<double>(now - last_).count() < every_) return;
   last_ = now;
-  const double frac = std::min(1.0, sim.time() / end_), rate = double(steps_done) / std::max(elapsed, 1e-9);
+  const double frac = std::min(1.0, time / end_), rate = double(steps_done) / std::max(elapsed, 1e-9);
   const double eta = frac > 0 ? elapsed * (1 - frac) / frac : 0;
   std::ostringstream s;
-  s << std::setprecision(4) << "t = " << sim.time() << " / " << end_ << "  step " << sim.step() << "  "
+  s << std::setprecision(4) << "t = " << time << " / " << end_ << "  step " << step << "  "
     << rate << " steps/s  ETA " << std::fixed << std::setprecision(0) << eta << " s";
-  const double wall = sim.op().min_wall_distance();
-  if (std::isfinite(wall)) s << std::scientific << std::setprecision(3) << "  closest wall approach " << wall;
+  if (const double wall = wall_distance(); std::isfinite(wall)) s << std::scientific << std::setprecision(3) << "  closest wall approach " << wall;
   if (tty_) {
     const int width = 30, done = static_cast<int>(frac * width);
     out_ << "\r[" << std::string(done, '#') << std::string(width - done, '.') << "] " << s.str() << "   " << std::flush;

@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include "immerse/app/Diagnostics.hpp"
+#include "immerse/app/DistributedRun.hpp"
 #include "immerse/app/MeshCopies.hpp"
 #include "immerse/app/RunOutput.hpp"
 #include "immerse/app/RunSettings.hpp"
@@ -19,19 +20,20 @@
 #include "immerse/core/Error.hpp"
 #include "immerse/core/MemoryLimits.hpp"
 #include "immerse/membrane/Geometry.hpp"
+#include "immerse/parallel/Communicator.hpp"
 #include "immerse/simulation/RunSchema.hpp"
 #include "immerse/simulation/Simulation.hpp"
 
 namespace immerse {
 
-namespace {
-
-void check_paths(const RunOptions& options) {
+void check_run_paths(const RunOptions& options) {
   if (options.out.empty()) throw InputError("--out: an empty name was given: must name a folder");
   if (!options.restart.empty() && std::filesystem::is_directory(options.restart))
     throw InputError("--restart " + options.restart.string() + " is a folder: must name a checkpoint file (e.g. " +
                      (options.restart / "checkpoint.h5").string() + ")");
 }
+
+namespace {
 
 std::string grid_text(const io::Config& c) {
   return "grid " + std::to_string(c.get<int>("grid.nx")) + " x " + std::to_string(c.get<int>("grid.ny")) + " x " +
@@ -121,9 +123,10 @@ void list_scenarios(const std::filesystem::path& dir, std::ostream& out) {
 }
 
 int run_command(const RunOptions& options, std::ostream& out, std::ostream& err) {
+  if (Communicator::world().size() > 1) return run_distributed(options, out, err);
   StopSignals signals;
   // 1. Everything that can be wrong with the input is found before anything is written.
-  check_paths(options);
+  check_run_paths(options);
   const io::ConfigSchema schema = run_schema();
   const io::Config config = apply_scenario(schema.parse_file(options.file, options.sets));
   const RunSettings settings = RunSettings::from(config);

@@ -10,9 +10,13 @@
 
 namespace immerse {
 
+/// `out` and `err` are written by rank 0 only when the program runs over several MPI processes (run_distributed).
 /// Exit status: 0 done, 2 bad input (nothing written), 3 the run became unstable, 4 interrupted by a signal,
 /// 5 an output file could not be written during the run (full disk; no further write, earlier files complete).
 int run_command(const RunOptions& options, std::ostream& out, std::ostream& err);
+
+/// InputError for an empty --out or a --restart naming a folder.
+void check_run_paths(const RunOptions& options);
 
 /// Prints the bundled scenarios (scenarios/*.toml) with the first comment line of each.
 void list_scenarios(const std::filesystem::path& dir, std::ostream& out);

@@ -10,29 +10,12 @@
 
 #include "immerse/core/Error.hpp"
 #include "immerse/io/AtomicFile.hpp"
+#include "immerse/io/Fnv1a64.hpp"
 #include "immerse/io/Hdf5.hpp"
 
 namespace immerse::io {
 
 namespace {
-
-// FNV-1a, 64 bit.
-class Fnv1a64 {
- public:
-  void bytes(const void* p, std::size_t n) {
-    const auto* b = static_cast<const unsigned char*>(p);
-    for (std::size_t i = 0; i < n; ++i) h_ = (h_ ^ b[i]) * 0x100000001b3ull;
-  }
-  void u64(std::uint64_t v) { bytes(&v, sizeof v); }
-  void text(const std::string& s) {
-    u64(s.size());
-    bytes(s.data(), s.size());
-  }
-  std::uint64_t value() const { return h_; }
-
- private:
-  std::uint64_t h_ = 0xcbf29ce484222325ull;
-};
 
 constexpr const char* kVersionAttr = "immerse_checkpoint_format";
 constexpr const char* kChecksumAttr = "checksum_fnv1a64";

@@ -51,6 +51,12 @@ const char* kSeriesTail = "    </Grid>\n  </Domain>\n</Xdmf>\n";
 const char* kMembraneAttr = "xdmf_membranes";
 const char* kFluidAttr = "xdmf_fluid";
 
+std::string frame_tag(int frame) {
+  char tag[16];
+  std::snprintf(tag, sizeof tag, "%06d", frame);
+  return tag;
+}
+
 }  // namespace
 
 std::string XdmfWriter::frame_file_name(int frame) {
@@ -88,9 +94,6 @@ std::filesystem::path XdmfWriter::write_frame(double time, std::span<const Surfa
   const int frame = frames();
   const std::string fname = frame_file_name(frame);
   const std::filesystem::path path = dir_ / fname;
-  const std::string t = format_number(time);
-  char tag[16];
-  std::snprintf(tag, sizeof tag, "%06d", frame);
 
   // Built in memory, then written atomically in one piece (see hdf5::create_memory_file).
   const auto check = [&](bool ok, const std::string& what) {
@@ -146,15 +149,7 @@ std::filesystem::path XdmfWriter::write_frame(double time, std::span<const Surfa
     check(hdf5::write_int32(g.get(), "membrane_id", id.data(), {nt}), "/membranes/membrane_id");
     check(hdf5::write_int64(g.get(), "node_offsets", node_offsets.data(), {node_offsets.size()}),
           "/membranes/node_offsets");
-    mx = "    <Grid Name=\"membranes_" + std::string(tag) + "\" GridType=\"Uniform\">\n      <Time Value=\"" + t +
-         "\"/>\n      <Information Name=\"membrane_names\" Value=\"" + names + "\"/>\n"
-         "      <Topology TopologyType=\"Triangle_6\" NumberOfElements=\"" + std::to_string(nt) + "\">\n"
-         "        " + data_item(fname, "/membranes/connectivity", {nt, 6}, true) + "\n      </Topology>\n"
-         "      <Geometry GeometryType=\"XYZ\">\n        " + data_item(fname, "/membranes/nodes", {nn, 3}, false) +
-         "\n      </Geometry>\n" +
-         attribute("membrane_id", "Scalar", "Cell", data_item(fname, "/membranes/membrane_id", {nt}, true)) +
-         // The node positions again as a field: readers of a fixed mesh (meshio) get the moving surface per frame.
-         attribute("position", "Vector", "Node", data_item(fname, "/membranes/nodes", {nn, 3}, false));
+    std::vector<std::pair<std::string, std::size_t>> fields;
     const auto field = [&](const std::string& name, auto member, std::size_t width) {
       check_name("field", name);
       std::vector<double> all;
@@ -172,13 +167,13 @@ std::filesystem::path XdmfWriter::write_frame(double time, std::span<const Surfa
       }
       const std::vector<hsize_t> dims = width == 3 ? std::vector<hsize_t>{nn, 3} : std::vector<hsize_t>{nn};
       check(hdf5::write_doubles(g.get(), name, all.data(), dims), "/membranes/" + name);
-      mx += attribute(name, width == 3 ? "Vector" : "Scalar", "Node", data_item(fname, "/membranes/" + name, dims, false));
+      fields.emplace_back(name, width);
     };
     for (std::size_t i = 0; i < membranes.front().vectors.size(); ++i)
       field(membranes.front().vectors[i].first, [i](const SurfaceFrame& m) { return m.vectors[i].second; }, 3);
     for (std::size_t i = 0; i < membranes.front().scalars.size(); ++i)
       field(membranes.front().scalars[i].first, [i](const SurfaceFrame& m) { return m.scalars[i].second; }, 1);
-    mx += "    </Grid>\n";
+    mx = membranes_fragment(fname, frame, time, names, nn, nt, fields);
     check(g.close(), "/membranes");
   }
 
@@ -203,19 +198,7 @@ std::filesystem::path XdmfWriter::write_frame(double time, std::span<const Surfa
               hdf5::write_doubles(fg.get(), "vorticity_magnitude", cells.vorticity_magnitude.data(), sdims) &&
               fg.close(),
           "/fluid");
-    const double h = g.h();
-    const Vec3 c0 = g.cell_position(0, 0, 0);
-    fx = "    <Grid Name=\"fluid_" + std::string(tag) + "\" GridType=\"Uniform\">\n      <Time Value=\"" + t +
-         "\"/>\n      <Topology TopologyType=\"3DCoRectMesh\" Dimensions=\"" + dims_text(sdims) +
-         "\"/>\n      <Geometry GeometryType=\"ORIGIN_DXDYDZ\">\n"
-         "        <DataItem Dimensions=\"3\" NumberType=\"Float\" Precision=\"8\" Format=\"XML\">" +
-         format_number(c0.z) + " " + format_number(c0.y) + " " + format_number(c0.x) +
-         "</DataItem>\n        <DataItem Dimensions=\"3\" NumberType=\"Float\" Precision=\"8\" Format=\"XML\">" +
-         format_number(h) + " " + format_number(h) + " " + format_number(h) + "</DataItem>\n      </Geometry>\n" +
-         attribute("velocity", "Vector", "Node", data_item(fname, "/fluid/velocity", vdims, false)) +
-         attribute("pressure", "Scalar", "Node", data_item(fname, "/fluid/pressure", sdims, false)) +
-         attribute("vorticity_magnitude", "Scalar", "Node", data_item(fname, "/fluid/vorticity_magnitude", sdims, false)) +
-         "    </Grid>\n";
+    fx = fluid_fragment(fname, frame, time, g);
   }
   check(hdf5::write_attribute(file.get(), kMembraneAttr, mx) && hdf5::write_attribute(file.get(), kFluidAttr, fx),
         "XDMF fragments");
@@ -224,10 +207,55 @@ std::filesystem::path XdmfWriter::write_frame(double time, std::span<const Surfa
   check(file.close(), "the file image");
   AtomicFile::write(path, image);
 
-  append_to_series("membranes", mx);
-  append_to_series("fluid", fx);
-  ++frames_;
+  append_frame(mx, fx);
   return path;
+}
+
+std::string XdmfWriter::fluid_fragment(const std::string& file, int frame, double time, const Grid& g) {
+  const auto& n = g.n();
+  const std::vector<hsize_t> sdims{hsize_t(n[2]), hsize_t(n[1]), hsize_t(n[0])};
+  const std::vector<hsize_t> vdims{hsize_t(n[2]), hsize_t(n[1]), hsize_t(n[0]), 3};
+  const double h = g.h();
+  const Vec3 c0 = g.cell_position(0, 0, 0);
+  return "    <Grid Name=\"fluid_" + frame_tag(frame) + "\" GridType=\"Uniform\">\n      <Time Value=\"" +
+         format_number(time) + "\"/>\n      <Topology TopologyType=\"3DCoRectMesh\" Dimensions=\"" + dims_text(sdims) +
+         "\"/>\n      <Geometry GeometryType=\"ORIGIN_DXDYDZ\">\n"
+         "        <DataItem Dimensions=\"3\" NumberType=\"Float\" Precision=\"8\" Format=\"XML\">" +
+         format_number(c0.z) + " " + format_number(c0.y) + " " + format_number(c0.x) +
+         "</DataItem>\n        <DataItem Dimensions=\"3\" NumberType=\"Float\" Precision=\"8\" Format=\"XML\">" +
+         format_number(h) + " " + format_number(h) + " " + format_number(h) + "</DataItem>\n      </Geometry>\n" +
+         attribute("velocity", "Vector", "Node", data_item(file, "/fluid/velocity", vdims, false)) +
+         attribute("pressure", "Scalar", "Node", data_item(file, "/fluid/pressure", sdims, false)) +
+         attribute("vorticity_magnitude", "Scalar", "Node",
+                   data_item(file, "/fluid/vorticity_magnitude", sdims, false)) +
+         "    </Grid>\n";
+}
+
+std::string XdmfWriter::membranes_fragment(const std::string& file, int frame, double time, const std::string& names,
+                                           std::size_t nodes, std::size_t triangles,
+                                           const std::vector<std::pair<std::string, std::size_t>>& fields) {
+  const hsize_t nn = nodes, nt = triangles;
+  std::string mx =
+      "    <Grid Name=\"membranes_" + frame_tag(frame) + "\" GridType=\"Uniform\">\n      <Time Value=\"" +
+      format_number(time) + "\"/>\n      <Information Name=\"membrane_names\" Value=\"" + names + "\"/>\n"
+      "      <Topology TopologyType=\"Triangle_6\" NumberOfElements=\"" + std::to_string(nt) + "\">\n"
+      "        " + data_item(file, "/membranes/connectivity", {nt, 6}, true) + "\n      </Topology>\n"
+      "      <Geometry GeometryType=\"XYZ\">\n        " + data_item(file, "/membranes/nodes", {nn, 3}, false) +
+      "\n      </Geometry>\n" +
+      attribute("membrane_id", "Scalar", "Cell", data_item(file, "/membranes/membrane_id", {nt}, true)) +
+      // The node positions again as a field: readers of a fixed mesh (meshio) get the moving surface per frame.
+      attribute("position", "Vector", "Node", data_item(file, "/membranes/nodes", {nn, 3}, false));
+  for (const auto& [name, width] : fields) {
+    const std::vector<hsize_t> dims = width == 3 ? std::vector<hsize_t>{nn, 3} : std::vector<hsize_t>{nn};
+    mx += attribute(name, width == 3 ? "Vector" : "Scalar", "Node", data_item(file, "/membranes/" + name, dims, false));
+  }
+  return mx + "    </Grid>\n";
+}
+
+void XdmfWriter::append_frame(const std::string& membranes, const std::string& fluid) {
+  append_to_series("membranes", membranes);
+  append_to_series("fluid", fluid);
+  ++frames_;
 }
 
 std::string XdmfWriter::series_head(const std::string& name) {

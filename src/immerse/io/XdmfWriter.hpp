@@ -63,6 +63,18 @@ class XdmfWriter {
     attributes_ = std::move(attributes);
   }
 
+  /// Appends frame number frames(), whose file another writer made (ParallelFrameWriter), to both series.
+  void append_frame(const std::string& membranes_fragment, const std::string& fluid_fragment);
+  /// The XDMF fragments of frame `frame` in `file`, as write_frame stores and appends them: the membranes (names
+  /// space-separated, node and triangle counts, the fields after position with 3 or 1 values per node) and the fluid.
+  static std::string membranes_fragment(const std::string& file, int frame, double time, const std::string& names,
+                                        std::size_t nodes, std::size_t triangles,
+                                        const std::vector<std::pair<std::string, std::size_t>>& fields);
+  static std::string fluid_fragment(const std::string& file, int frame, double time, const Grid& grid);
+  /// The names of the root attributes holding a frame file's two fragments.
+  static constexpr const char* kMembranesAttribute = "xdmf_membranes";
+  static constexpr const char* kFluidAttribute = "xdmf_fluid";
+
   int frames() const { return frames_; }
   const std::filesystem::path& dir() const { return dir_; }
   static std::string frame_file_name(int frame);

@@ -9,6 +9,8 @@
 #include "immerse/core/Error.hpp"
 #include "immerse/coupling/DeltaKernel.hpp"
 #include "immerse/membrane/VolumeCorrection.hpp"
+#include "immerse/parallel/Agreement.hpp"
+#include "immerse/simulation/CheckpointEntries.hpp"
 #include "immerse/simulation/RunSetup.hpp"
 
 namespace immerse {
@@ -149,15 +151,104 @@ void DistributedSimulation::check_stability() const {
   for (int d = 0; d < 3 && what.empty(); ++d)
     for (double v : f.u[d].values())
       if (!(std::abs(v) <= max_speed_)) {
-        what = "unstable at step " + std::to_string(step_) + ": fluid velocity u_" + "xyz"[d] +
-               " is not finite or exceeds time.max_speed (runaway)";
+        std::ostringstream s;
+        s.precision(10);
+        s << "unstable at step " << step_ << ", t = " << time() << ": fluid velocity u_" << "xyz"[d]
+          << " is not finite or exceeds time.max_speed (runaway)";
+        what = s.str();
         break;
       }
-  if (what.empty() && !std::ranges::all_of(f.p.values(), [](double v) { return std::isfinite(v); }))
-    what = "unstable at step " + std::to_string(step_) + ": fluid pressure is not finite";
+  if (what.empty() && !std::ranges::all_of(f.p.values(), [](double v) { return std::isfinite(v); })) {
+    std::ostringstream s;
+    s.precision(10);
+    s << "unstable at step " << step_ << ", t = " << time() << ": fluid pressure is not finite";
+    what = s.str();
+  }
   const Communicator& comm = fluid_.decomposition().communicator();
-  if (comm.sum(what.empty() ? 0.0 : 1.0) > 0)
-    throw SimulationError(what.empty() ? "unstable at step " + std::to_string(step_) + " on another process" : what);
+  // Every process stops with the message of the lowest-ranked process that found the run unstable.
+  if (const std::string first = first_error(comm, what); !first.empty()) throw SimulationError(first);
+}
+
+void DistributedSimulation::restore(const io::Checkpoint& ck) {
+  check_checkpoint_configuration(config_, ck);
+  const CheckpointEntries entries(ck);
+  // The whole-grid state, checked entry by entry as Simulation::restore does, then cut into this run's slabs.
+  FluidState f = run_initial_fluid_state(config_, grid_, fluid_.params());
+  for (int d = 0; d < 3; ++d) {
+    const std::size_t n = f.u[d].values().size();
+    f.u[d].values() = entries.array("fluid.u" + std::to_string(d), n);
+    if (f.adv[d].size() != f.u[d].size()) f.adv[d] = f.u[d];
+    f.adv[d].values() = entries.array("fluid.adv" + std::to_string(d), n);
+    const std::string prev = "fluid.u_prev" + std::to_string(d);
+    if (ck.has(prev)) {
+      if (f.u_prev[d].size() != f.u[d].size()) f.u_prev[d] = f.u[d];
+      f.u_prev[d].values() = entries.array(prev, n);
+    }
+  }
+  f.p.values() = entries.array("fluid.p", f.p.values().size());
+  f.dt_prev = entries.time_value("fluid.dt_prev");
+  if (ck.has("fluid.p_prev")) {
+    if (f.p_prev.size() != f.p.size()) f.p_prev = f.p;
+    f.p_prev.values() = entries.array("fluid.p_prev", f.p.values().size());
+    f.dt_prev2 = entries.time_value("fluid.dt_prev2");
+  }
+  f.step = entries.count("fluid.step");
+  f.time = entries.time_value("fluid.time");
+  const std::size_t M = num_membranes();
+  std::vector<std::vector<Vec3>> X(M);
+  std::vector<std::size_t> first(M + 1, 0);  // of each membrane's unknowns in the global concatenation
+  for (std::size_t m = 0; m < M; ++m) {
+    const std::string name = "membrane[" + std::to_string(m) + "]";
+    const auto& R = membranes_.references[m];
+    if (ck.array(name + ".reference") != std::vector<double>(&R[0].x, &R[0].x + 3 * R.size()))
+      throw InputError("checkpoint: the reference state of " + name +
+                       " differs from the one this configuration builds (was its mesh file changed?)");
+    const auto& a3 = entries.array(name + ".positions", 3 * R.size());
+    X[m].resize(a3.size() / 3);
+    for (std::size_t i = 0; i < X[m].size(); ++i) X[m][i] = {a3[3 * i], a3[3 * i + 1], a3[3 * i + 2]};
+    first[m + 1] = first[m] + a3.size();
+  }
+  const std::size_t unknowns = first[M];
+  const std::string previous = "integrator.previous_positions", errors = "integrator.guess_errors";
+  const auto& prev_X = entries.array(previous, ck.array(previous).empty() ? 0 : unknowns);
+  const double prev_dt = entries.time_value("integrator.previous_dt");
+  const std::vector<double> guess_errors =
+      ck.has(errors) ? entries.array(errors, ck.array(errors).size()) : std::vector<double>{};
+  if (guess_errors.size() % std::max<std::size_t>(unknowns, 1) != 0)
+    ck.invalid(errors, "has " + std::to_string(guess_errors.size()) + " values, not a multiple of the " +
+                           std::to_string(unknowns) + " unknowns");
+  const double dt = ck.get_double("stepper.dt");
+  entries.number("stepper.dt", dt, std::isfinite(dt) && dt > 0 && dt <= config_.get<double>("time.dt"),
+                 "in (0, time.dt]");
+  const std::int64_t successes = entries.count("stepper.successes");
+  const std::int64_t step = entries.count("step");
+  if (f.time >= end_time_ * (1 - 1e-12)) {
+    std::ostringstream s;
+    s << "time.end = " << end_time_ << ": must be later than the time of the checkpoint " << ck.source() << ", t = "
+      << f.time << " (nothing left to run)";
+    throw InputError(s.str());
+  }
+  std::vector<const ElasticMembrane*> ms;
+  for (const auto& m : membranes_.membranes) ms.push_back(m.get());
+  op_ = std::make_unique<DistributedOperator>(fluid_, coupler_, std::move(ms), X, membranes_.references,
+                                              fluid_.scatter(f), run_contact_settings(config_),
+                                              membranes_.viscosity_ratio);
+  integrator_->prepare(op_->size());
+  // The history of the nodes this process now owns, in its order (each stored vector: all unknowns, global order).
+  const auto owned_part = [&](std::span<const double> global) {
+    std::vector<double> part;
+    for (std::size_t k = 0; k < global.size() / std::max<std::size_t>(unknowns, 1); ++k)
+      for (const OwnedMembrane& m : op_->ownership().owned()) {
+        const auto id = static_cast<std::size_t>(m.id);
+        const auto from = global.begin() + static_cast<std::ptrdiff_t>(k * unknowns + first[id]);
+        part.insert(part.end(), from, from + static_cast<std::ptrdiff_t>(first[id + 1] - first[id]));
+      }
+    return part;
+  };
+  integrator_->set_history(owned_part(prev_X), prev_dt, owned_part(guess_errors),
+                           guess_errors.size() / std::max<std::size_t>(unknowns, 1));
+  stepper_.set_state(dt, static_cast<int>(successes));
+  step_ = step;
 }
 
 }  // namespace immerse

@@ -19,12 +19,14 @@
 // result equals Simulation's to round-off (the spreading sums, see DistributedOperator.hpp, and the order of the sums
 // in the solvers' norms) and is bitwise the same in every run with the same number of processes.
 //
-// Refused with InputError: the dense "bfgs" (its matrix spans all unknowns). Output and checkpoints are the caller's
-// (DistributedRun gathers what it needs: gather_positions(), gather_fluid_state()).
+// Refused with InputError: the dense "bfgs" (its matrix spans all unknowns). Output and checkpoints are written by
+// the caller (`immerse run` under mpirun: app/DistributedRun.hpp) from the accessors below; restore() continues from
+// a checkpoint.
 // Construction and advance() are collective over the communicator. No global state.
 // Verified by: the tests ParallelRun.* (tests/test_parallel_run.cpp, 1 to 4 processes: the quick red-cell channel
 // with explicit and implicit schemes against the one-process Simulation within 1e-10, repeated bitwise, the same
-// iteration counts, also with λ = 5 cells and the volume correction; the refusals).
+// iteration counts, also with λ = 5 cells and the volume correction; the refusal); restore() by RunMpi.*
+// (tests/test_run_mpi.cpp: a checkpoint of 2 processes continued on 3).
 #include <functional>
 #include <memory>
 #include <string>
@@ -35,6 +37,7 @@
 #include "immerse/fluid/FluidState.hpp"
 #include "immerse/fluid/SlabNavierStokesSolver.hpp"
 #include "immerse/grid/Grid.hpp"
+#include "immerse/io/Checkpoint.hpp"
 #include "immerse/io/Config.hpp"
 #include "immerse/parallel/Communicator.hpp"
 #include "immerse/simulation/DistributedOperator.hpp"
@@ -64,7 +67,6 @@ class DistributedSimulation {
   double time() const { return op_->fluid_state().time; }
   const Grid& grid() const { return grid_; }
   const DistributedOperator& op() const { return *op_; }
-  const MembraneIntegrator& integrator() const { return *integrator_; }
   std::size_t num_membranes() const { return membranes_.membranes.size(); }
   /// Membranes moved between processes so far.
   int migrations() const { return op_->migrations(); }
@@ -73,6 +75,22 @@ class DistributedSimulation {
   std::vector<std::vector<Vec3>> gather_positions() const { return op_->ownership().gather_positions(); }
   /// The whole-grid fluid state, on every process. Collective.
   FluidState gather_fluid_state() const { return fluid_.gather(op_->fluid_state()); }
+
+  /// What output and checkpoints read: the resolved configuration, the slab fluid solver (its decomposition), the
+  /// membranes of the run (meshes, force objects, reference positions; all of them on every process) and the
+  /// integrator (its history, of the owned nodes).
+  const io::Config& config() const { return config_; }
+  const SlabNavierStokesSolver& fluid() const { return fluid_; }
+  const MembraneSet& membranes() const { return membranes_; }
+  const MembraneIntegrator& integrator() const { return *integrator_; }
+  /// The step control (the current step and the accepted steps since it was last changed), saved in checkpoints.
+  const AdaptiveStepper& stepper() const { return stepper_; }
+
+  /// Continues from a checkpoint of the same configuration written by any number of processes (or by Simulation):
+  /// every process passes the whole checkpoint; the fluid is cut into this run's slabs and the membranes are owned
+  /// by the processes holding their centroids. The integrator history (previous positions and guess errors, per node
+  /// in global membrane order) is taken for the owned nodes. InputError as Simulation::restore. Collective.
+  void restore(const io::Checkpoint& ck);
 
  private:
   void check_stability() const;

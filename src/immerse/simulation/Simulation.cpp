@@ -8,6 +8,7 @@
 #include "immerse/core/Error.hpp"
 #include "immerse/coupling/NodeDiagnostics.hpp"
 #include "immerse/membrane/VolumeCorrection.hpp"
+#include "immerse/simulation/CheckpointEntries.hpp"
 #include "immerse/simulation/MembraneSet.hpp"
 #include "immerse/simulation/RunSchema.hpp"
 #include "immerse/simulation/RunSetup.hpp"
@@ -175,58 +176,15 @@ io::Checkpoint Simulation::checkpoint() const {
 }
 
 void Simulation::restore(const io::Checkpoint& ck) {
-  // The checkpoint's configuration must be this one, up to the keys a continued or branched run may change and
-  // the names of mesh files (a run folder's copy stands for its original; what the files hold is compared with
-  // the reference state below).
-  io::Config theirs = config_.schema().parse_string(ck.get_string("config"), "checkpoint");
-  leave_out_inapplicable(theirs);
-  const auto may_change = [](const std::string& key) {
-    return key == "time.end" || key == "scenario.kt_end" || key.starts_with("output.") || key.starts_with("solver.") ||
-           key == "mesh.file" || key == "mesh.reference_file";
+  check_checkpoint_configuration(config_, ck);
+  const CheckpointEntries entries(ck);
+  const auto number = [&](const std::string& name, double v, bool ok, const std::string& allowed) {
+    return entries.number(name, v, ok, allowed);
   };
-  const auto differ = [&](const std::string& key, const std::string& was, const std::string& is) {
-    throw InputError(key + " = " + is + ": the checkpoint " + ck.source() + " was written with " + key + " = " + was +
-                     " (on restart only time.end, scenario.kt_end, [output] and [solver] keys may change)");
-  };
-  for (const auto& k : config_.schema().keys())
-    if (!may_change(k.key) && theirs.value_text(k.key) != config_.value_text(k.key))
-      differ(k.key, theirs.value_text(k.key), config_.value_text(k.key));
-  for (const auto& t : config_.schema().table_arrays()) {
-    if (theirs.count(t.name) != config_.count(t.name))
-      differ("[[" + t.name + "]] count", std::to_string(theirs.count(t.name)), std::to_string(config_.count(t.name)));
-    for (std::size_t i = 0; i < config_.count(t.name); ++i)
-      for (const auto& k : config_.entry(t.name, i).schema().keys()) {
-        if (may_change(k.key)) continue;
-        const std::string was = theirs.entry(t.name, i).value_text(k.key), is = config_.entry(t.name, i).value_text(k.key);
-        if (was != is) differ(t.name + "[" + std::to_string(i) + "]." + k.key, was, is);
-      }
-  }
-  // Every entry is checked before it is used, so that a damaged checkpoint whose checksum was recomputed is
-  // refused by name instead of failing later in the run.
-  auto number = [&](const std::string& name, double v, bool ok, const std::string& allowed) {
-    if (ok) return v;
-    std::ostringstream s;
-    s << "= " << v << ": must be " << allowed;
-    ck.invalid(name, s.str());
-  };
-  auto count = [&](const std::string& name) {
-    const std::int64_t v = ck.get_int(name);
-    number(name, double(v), v >= 0, "an integer >= 0");
-    return v;
-  };
-  auto time_value = [&](const std::string& name) {
-    const double v = ck.get_double(name);
-    return number(name, v, std::isfinite(v) && v >= 0, "a finite number >= 0");
-  };
-  auto array = [&](const std::string& name, std::size_t size) -> const std::vector<double>& {
-    const auto& values = ck.array(name);
-    if (values.size() != size)
-      ck.invalid(name, "has " + std::to_string(values.size()) + " values, this configuration needs " +
-                           std::to_string(size));
-    for (std::size_t i = 0; i < values.size(); ++i)
-      if (!std::isfinite(values[i]))
-        ck.invalid(name, "has a value that is not finite (index " + std::to_string(i) + ")");
-    return values;
+  const auto count = [&](const std::string& name) { return entries.count(name); };
+  const auto time_value = [&](const std::string& name) { return entries.time_value(name); };
+  const auto array = [&](const std::string& name, std::size_t size) -> const std::vector<double>& {
+    return entries.array(name, size);
   };
   FluidState f = fluid_.initial_state();
   for (int d = 0; d < 3; ++d) {
