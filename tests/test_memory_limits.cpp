@@ -4,6 +4,7 @@
 
 #include <filesystem>
 #include <fstream>
+#include <vector>
 
 #include <unistd.h>
 
@@ -52,4 +53,17 @@ TEST(MemoryLimits, ThisProcessHasItsMachinesMemoryAmongItsLimits) {
   EXPECT_EQ(limits[0].what.rfind("this machine's memory (", 0), 0u);
   EXPECT_GT(limits[0].bytes, 1e8);
   EXPECT_EQ(gigabytes(4.19e9), "4.19 GB");
+}
+
+TEST(MemoryLimits, PeakResidentMemoryGrowsWithWhatThisProcessTouches) {
+  const auto before = peak_resident_bytes();
+  ASSERT_TRUE(before.has_value());
+  EXPECT_GT(*before, 1e6);
+  // 64 MB written page by page is resident at once: the peak rises by about that much.
+  std::vector<char> block(64u << 20);
+  for (std::size_t i = 0; i < block.size(); i += 4096) block[i] = static_cast<char>(i);
+  const auto after = peak_resident_bytes();
+  ASSERT_TRUE(after.has_value());
+  EXPECT_EQ(block[8192], static_cast<char>(8192 % 256));
+  EXPECT_GE(*after, *before + 0.9 * double(block.size())) << *before;
 }

@@ -270,6 +270,43 @@ TEST(RunMpi, ImplicitRunWithViscosityContrastContinuesOnAnotherProcessCountAsThe
   EXPECT_GT(relative_difference(positions(half), positions(reference)), 1e-6);
 }
 
+// The suspension between sliding walls (λ = 5 cells packed to H = 0.2, contact, the volume correction, JFNK; cells of
+// 642 nodes to keep it short): its
+// run columns (volume fraction, the two wall stresses with χ, relative viscosity) from the first and the last slab.
+TEST(RunMpi, SuspensionShearOnThreeProcessesWritesTheOneProcessViscosity) {
+  ScratchDir dir("run_mpi");
+  const auto args = [&](const fs::path& out) {
+    return run_args(scenario_file("suspension_shear_quick.toml"), out,
+                    {"time.end=3e-4", "membrane[0].mesh.level=2", "output.fields_every=0",
+                     "output.checkpoint_every=0"});
+  };
+  const auto one = run_mpi(1, args(dir / "one"), dir / "one");
+  ASSERT_EQ(one.status, 0) << one.err;
+  const auto three = run_mpi(3, args(dir / "three"), dir / "three");
+  ASSERT_EQ(three.status, 0) << three.err;
+  const auto a = read_csv(dir / "one" / "diagnostics.csv");
+  const auto b = read_csv(dir / "three" / "diagnostics.csv");
+  ASSERT_EQ(a.size(), 5u);  // header, steps 0 to 3
+  ASSERT_EQ(b.size(), a.size());
+  ASSERT_EQ(b[0], a[0]);
+  double largest = 0;
+  for (const char* name : {"volume_fraction", "wall_stress_lower", "wall_stress_upper", "relative_viscosity"}) {
+    const auto c = static_cast<std::size_t>(std::find(a[0].begin(), a[0].end(), name) - a[0].begin());
+    ASSERT_LT(c, a[0].size()) << name;
+    for (std::size_t row = 1; row < a.size(); ++row) {
+      const double x = std::stod(b[row][c]), y = std::stod(a[row][c]);
+      EXPECT_LE(std::abs(x - y), 1e-10 * std::abs(y)) << name << " at step " << row - 1;
+      largest = std::max(largest, std::abs(x - y) / std::abs(y));
+    }
+  }
+  const auto viscosity = static_cast<std::size_t>(
+      std::find(a[0].begin(), a[0].end(), "relative_viscosity") - a[0].begin());
+  EXPECT_GT(std::stod(a[3][viscosity]), 1.0);  // the cells raise the wall stress
+  std::printf("[RunMpi] suspension_shear, 3 processes against one: relative viscosity at step 3 %s, largest relative "
+              "difference of the run columns %.2g\n",
+              b[3][viscosity].c_str(), largest);
+}
+
 TEST(RunMpi, TwoProcessRunsGiveBitwiseTheSameCheckpoint) {
   ScratchDir dir("run_mpi");
   const auto a = run_mpi(2, channel_args(dir / "a", 3), dir / "a");

@@ -23,9 +23,12 @@
 #include "immerse/app/ScenarioRun.hpp"
 #include "immerse/app/ShearPlaneProfile.hpp"
 #include "immerse/app/StopSignals.hpp"
+#include "immerse/app/SuspensionShearRun.hpp"
 #include "immerse/core/Error.hpp"
+#include "immerse/core/MemoryLimits.hpp"
 #include "immerse/core/ThreadGovernor.hpp"
 #include "immerse/coupling/NodeDiagnostics.hpp"
+#include "immerse/fluid/FluidDiagnostics.hpp"
 #include "immerse/io/AtomicFile.hpp"
 #include "immerse/io/CellFields.hpp"
 #include "immerse/io/OutputFolder.hpp"
@@ -71,10 +74,10 @@ void check_process_count(const io::Config& config, int processes) {
 // the steps or tables of their own that the distributed run does not have.
 void check_scenario_kind(const io::Config& config, int processes) {
   const std::string kind = config.get<std::string>("scenario.kind");
-  if (kind == "rbc_channel" || kind == "custom" || is_shear_kind(kind)) return;
+  if (kind == "rbc_channel" || kind == "custom" || kind == "suspension_shear" || is_shear_kind(kind)) return;
   throw InputError("scenario.kind = \"" + kind + "\": a run over " + std::to_string(processes) +
-                   " MPI processes takes \"rbc_channel\", \"custom\" and the shear kinds (run this kind in one "
-                   "process)");
+                   " MPI processes takes \"rbc_channel\", \"suspension_shear\", \"custom\" and the shear kinds "
+                   "(run this kind in one process)");
 }
 
 /// Node offsets of the membranes in the global concatenation (global membrane order), and of their triangles.
@@ -290,6 +293,23 @@ double mean_velocity_y(const DistributedSimulation& sim) {
   for (double x : v) sum += x;
   const auto s = sim.grid().face_shape(1);
   return sim.fluid().decomposition().communicator().sum(sum) / (double(s[0]) * s[1] * s[2]);
+}
+
+/// The mean shear stresses on the lower and the upper z wall (wall_shear_stress), each from the slab holding the cell
+/// plane next to it, with χ of the last trial. Collective.
+std::pair<double, double> wall_stresses(const DistributedSimulation& sim, const SuspensionShearRun& run) {
+  const SlabDecomposition& slabs = sim.fluid().decomposition();
+  const Grid& grid = sim.grid();
+  const Array3& ux = sim.op().fluid_state().u[0];
+  const Array3* chi = &sim.op().viscosity_indicator();
+  const double lower =
+      slabs.first() ? wall_shear_stress_sum(grid, ux, chi, false, run.lower_wall_velocity(), 0 - slabs.offset()) : 0;
+  const double upper = slabs.last() ? wall_shear_stress_sum(grid, ux, chi, true, run.upper_wall_velocity(),
+                                                            grid.n(2) - 1 - slabs.offset())
+                                    : 0;
+  const double scale = run.viscosity() / (double(grid.n(0)) * double(grid.n(1)));
+  const Communicator& comm = slabs.communicator();
+  return {scale * comm.sum(lower), scale * comm.sum(upper)};
 }
 
 /// The closest approach of a node to a wall over all processes (not finite: no walls, or a node outside the box).
@@ -521,13 +541,17 @@ class DistributedLoop {
     if (last_.step != sim_.step()) return;
     const auto X = sim_.gather_positions();
     const double mean_velocity = channel_ ? mean_velocity_y(sim_) : 0;
+    const auto* suspension = dynamic_cast<const SuspensionShearRun*>(&scenario_);
+    const auto stresses = suspension ? wall_stresses(sim_, *suspension) : std::pair<double, double>{};
     on_root([&] {
       std::vector<double> row{double(last_.step), last_.time};
       if (shear_rate_ > 0) row.push_back(shear_rate_ * last_.time);
       row.insert(row.end(), {last_.dt, double(last_.stats.newton_its), double(last_.stats.gmres_its),
                              double(last_.stats.fluid_solves), last_.stats.residual, last_.wall_seconds});
+      double enclosed = 0;
       for (std::size_t m = 0; m < X.size(); ++m) {
         const MembraneGeometry g = measure(sim_.membranes().meshes[m], X[m]);
+        enclosed += g.volume;
         const ShearPlaneProfile p = shear_plane_profile(sim_.membranes().meshes[m], X[m], g.centroid);
         const auto a = semi_axes_along_xyz(g);
         row.insert(row.end(), {g.volume, g.area, g.centroid.x, g.centroid.y, g.centroid.z, a[0], a[1], a[2], p.D_xz,
@@ -535,6 +559,7 @@ class DistributedLoop {
         scenario_.add_membrane_values(X[m], row);
       }
       if (channel_) row.push_back(mean_velocity);
+      if (suspension) suspension->add_values(enclosed, stresses.first, stresses.second, row);
       root_->table().row(row);
     });
   }
@@ -688,6 +713,11 @@ int run_distributed(const RunOptions& options, std::ostream& out, std::ostream& 
          << " processes, " << sim->migrations() << " membranes changed process\n";
     log << took.str();
   }
+  // The peak resident memory of each process (VmHWM), the largest and the sum over the processes.
+  const double peak = peak_resident_bytes().value_or(0.0);
+  const double largest = -min_over_processes(comm, -peak), total = comm.sum(peak);
+  if (largest > 0)
+    log << "peak memory " << gigabytes(largest) << " on the largest process, " << gigabytes(total) << " in all\n";
   return status;
 }
 

@@ -92,6 +92,7 @@ void print_summary(const Simulation& sim, const TimeLoop& loop, int status, std:
     out << took.str() << loop.timings().profile(loop.stepping_seconds(), loop.steps()) << "\n";
     out << sim.op().thread_governor().summary() << "\n";
   }
+  if (const auto peak = peak_resident_bytes()) out << "peak memory " << gigabytes(*peak) << "\n";
   for (std::size_t m = 0; m < sim.num_membranes(); ++m) {
     const auto X = sim.op().membrane_positions(m);
     const auto g = measure(sim.mesh(m), X);

@@ -30,7 +30,12 @@ void SuspensionShearRun::add_run_values(const Simulation& sim, std::vector<doubl
   const Array3* chi = &sim.op().viscosity_indicator();
   const double lower = wall_shear_stress(sim.grid(), u, chi, mu_, false, lower_x_);
   const double upper = wall_shear_stress(sim.grid(), u, chi, mu_, true, upper_x_);
-  row.insert(row.end(), {volume / box_volume_, lower, upper, 0.5 * (lower + upper) / (mu_ * shear_rate_)});
+  add_values(volume, lower, upper, row);
+}
+
+void SuspensionShearRun::add_values(double enclosed_volume, double lower, double upper,
+                                    std::vector<double>& row) const {
+  row.insert(row.end(), {enclosed_volume / box_volume_, lower, upper, 0.5 * (lower + upper) / (mu_ * shear_rate_)});
 }
 
 }  // namespace immerse

@@ -60,4 +60,15 @@ std::vector<MemoryLimit> memory_limits() {
   return limits;
 }
 
+std::optional<double> peak_resident_bytes() {
+  std::ifstream in("/proc/self/status");
+  for (std::string line; std::getline(in, line);)
+    if (line.rfind("VmHWM:", 0) == 0) {
+      std::istringstream value(line.substr(6));
+      double kilobytes = 0;
+      if (value >> kilobytes) return kilobytes * 1024.0;
+    }
+  return std::nullopt;
+}
+
 }  // namespace immerse

@@ -53,18 +53,24 @@ double max_abs_velocity(const Grid& grid, const FaceField& u) {
 
 double wall_shear_stress(const Grid& grid, const FaceField& u, const Array3* chi, double mu, bool upper,
                          double wall_velocity_x) {
+  const double sum = wall_shear_stress_sum(grid, u[0], chi, upper, wall_velocity_x, upper ? grid.n(2) - 1 : 0);
+  return mu * sum / (double(grid.n(0)) * double(grid.n(1)));
+}
+
+double wall_shear_stress_sum(const Grid& grid, const Array3& ux, const Array3* chi, bool upper, double wall_velocity_x,
+                             int k) {
   if (grid.periodic(2) || !grid.periodic(0))
     throw std::invalid_argument("wall_shear_stress: needs walls along z and a periodic x axis");
-  const int nx = grid.n(0), ny = grid.n(1), k = upper ? grid.n(2) - 1 : 0;
+  const int nx = grid.n(0), ny = grid.n(1);
   const bool contrast = chi != nullptr && chi->size() > 0;
   double sum = 0;
   for (int j = 0; j < ny; ++j)
     for (int i = 0; i < nx; ++i) {
-      const double dudz = 2.0 * (upper ? wall_velocity_x - u[0](i, j, k) : u[0](i, j, k) - wall_velocity_x) / grid.h();
+      const double dudz = 2.0 * (upper ? wall_velocity_x - ux(i, j, k) : ux(i, j, k) - wall_velocity_x) / grid.h();
       const double c = contrast ? 0.5 * ((*chi)(i, j, k) + (*chi)((i + nx - 1) % nx, j, k)) : 0.0;
       sum += (1.0 + c) * dudz;
     }
-  return mu * sum / (double(nx) * double(ny));
+  return sum;
 }
 
 void apply_operator(const Grid& grid, Layout layout, const Array3& x, double alpha, double beta, Array3& out) {

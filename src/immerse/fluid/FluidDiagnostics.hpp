@@ -23,6 +23,11 @@ void divergence(const Grid& grid, const FaceField& u, Array3& div);
 /// and a periodic x axis (std::invalid_argument otherwise).
 double wall_shear_stress(const Grid& grid, const FaceField& u, const Array3* chi, double mu, bool upper,
                          double wall_velocity_x);
+/// The sum over the wall's n_x n_y edges of (1 + χ) ∂u_x/∂z of wall_shear_stress (which is μ times it over n_x n_y),
+/// with u_x and χ read at plane k of the arrays: 0 or n_z − 1 of whole-grid arrays, the plane next to the wall of a
+/// slab array (a distributed run, whose first and last processes add theirs).
+double wall_shear_stress_sum(const Grid& grid, const Array3& ux, const Array3* chi, bool upper, double wall_velocity_x,
+                             int k);
 
 /// Largest |value| of velocity over the unknown faces (all components).
 double max_abs_velocity(const Grid& grid, const FaceField& u);
