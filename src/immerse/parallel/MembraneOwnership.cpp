@@ -27,6 +27,25 @@ std::vector<Vec3> read(const double* in, int n) {
   return X;
 }
 
+/// out[r] sent to process r; returns what every process sent to this one, in rank order (one MPI_Alltoall of the
+/// counts, one MPI_Alltoallv). Collective.
+std::vector<double> exchange(const Communicator& comm, const std::vector<std::vector<double>>& out) {
+  const int size = comm.size();
+  std::vector<int> send_counts(size), send_offsets(size, 0), recv_counts(size), recv_offsets(size, 0);
+  for (int r = 0; r < size; ++r) send_counts[r] = static_cast<int>(out[r].size());
+  check(MPI_Alltoall(send_counts.data(), 1, MPI_INT, recv_counts.data(), 1, MPI_INT, comm.comm()), "MPI_Alltoall");
+  for (int r = 1; r < size; ++r) {
+    send_offsets[r] = send_offsets[r - 1] + send_counts[r - 1];
+    recv_offsets[r] = recv_offsets[r - 1] + recv_counts[r - 1];
+  }
+  std::vector<double> send, recv(static_cast<std::size_t>(recv_offsets[size - 1]) + recv_counts[size - 1]);
+  for (const std::vector<double>& o : out) send.insert(send.end(), o.begin(), o.end());
+  check(MPI_Alltoallv(send.data(), send_counts.data(), send_offsets.data(), MPI_DOUBLE, recv.data(),
+                      recv_counts.data(), recv_offsets.data(), MPI_DOUBLE, comm.comm()),
+        "MPI_Alltoallv");
+  return recv;
+}
+
 }  // namespace
 
 MembraneOwnership::MembraneOwnership(const SlabDecomposition& slabs, std::span<const std::vector<Vec3>> positions,
@@ -110,18 +129,7 @@ int MembraneOwnership::migrate() {
   const int leaving = static_cast<int>(owned_.size() - staying.size());
   owned_ = std::move(staying);
 
-  std::vector<int> send_counts(size), send_offsets(size, 0), recv_counts(size), recv_offsets(size, 0);
-  for (int r = 0; r < size; ++r) send_counts[r] = static_cast<int>(out[r].size());
-  check(MPI_Alltoall(send_counts.data(), 1, MPI_INT, recv_counts.data(), 1, MPI_INT, comm.comm()), "MPI_Alltoall");
-  for (int r = 1; r < size; ++r) {
-    send_offsets[r] = send_offsets[r - 1] + send_counts[r - 1];
-    recv_offsets[r] = recv_offsets[r - 1] + recv_counts[r - 1];
-  }
-  std::vector<double> send, recv(static_cast<std::size_t>(recv_offsets[size - 1]) + recv_counts[size - 1]);
-  for (const std::vector<double>& o : out) send.insert(send.end(), o.begin(), o.end());
-  check(MPI_Alltoallv(send.data(), send_counts.data(), send_offsets.data(), MPI_DOUBLE, recv.data(),
-                      recv_counts.data(), recv_offsets.data(), MPI_DOUBLE, comm.comm()),
-        "MPI_Alltoallv");
+  const std::vector<double> recv = exchange(comm, out);
   for (std::size_t at = 0; at < recv.size();) {
     const int id = static_cast<int>(recv[at]);
     const int n = node_counts_.at(static_cast<std::size_t>(id));
@@ -162,18 +170,7 @@ std::vector<double> MembraneOwnership::follow(std::span<const double> before, st
     }
     at += n;
   }
-  std::vector<int> send_counts(size), send_offsets(size, 0), recv_counts(size), recv_offsets(size, 0);
-  for (int r = 0; r < size; ++r) send_counts[r] = static_cast<int>(out[r].size());
-  check(MPI_Alltoall(send_counts.data(), 1, MPI_INT, recv_counts.data(), 1, MPI_INT, comm.comm()), "MPI_Alltoall");
-  for (int r = 1; r < size; ++r) {
-    send_offsets[r] = send_offsets[r - 1] + send_counts[r - 1];
-    recv_offsets[r] = recv_offsets[r - 1] + recv_counts[r - 1];
-  }
-  std::vector<double> send, recv(static_cast<std::size_t>(recv_offsets[size - 1]) + recv_counts[size - 1]);
-  for (const std::vector<double>& o : out) send.insert(send.end(), o.begin(), o.end());
-  check(MPI_Alltoallv(send.data(), send_counts.data(), send_offsets.data(), MPI_DOUBLE, recv.data(),
-                      recv_counts.data(), recv_offsets.data(), MPI_DOUBLE, comm.comm()),
-        "MPI_Alltoallv");
+  const std::vector<double> recv = exchange(comm, out);
   for (std::size_t q = 0; q < recv.size();) {
     const auto id = static_cast<std::size_t>(recv[q]);
     const std::size_t n = 3 * static_cast<std::size_t>(node_counts_.at(id));

@@ -242,13 +242,7 @@ void DistributedOperator::committed_velocity(std::span<const double> Xi, std::sp
 
 void DistributedOperator::correct_positions(std::span<const Vec3> X) {
   if (X.size() != X_.size()) throw std::logic_error("DistributedOperator::correct_positions: one position per node");
-  ownership_.set_owned_positions(X);
-  migrations_ += ownership_.migrate();
-  refresh();
-  U_.resize(X_.size());
-  coupler_.interpolate_velocity(committed_.u, X_, U_);
-  trial_X_.clear();
-  trial_done_ = false;
+  move_to(X);
   start_valid_ = false;  // S(X^n) f(X^n) at the corrected positions is computed when a trial needs it
 }
 
@@ -263,7 +257,11 @@ void DistributedOperator::commit(std::span<const double> X, double) {
   // Agreed by all processes (a process's part may match where another's does not, or be empty).
   start_valid_ = !any_failed(fluid_.decomposition().communicator(), !trial_matches(X));
   if (start_valid_) std::swap(force_start_, force_);
-  ownership_.set_owned_positions(nodes(X));
+  move_to(nodes(X));
+}
+
+void DistributedOperator::move_to(std::span<const Vec3> X) {
+  ownership_.set_owned_positions(X);
   migrations_ += ownership_.migrate();
   refresh();
   U_.resize(X_.size());

@@ -117,6 +117,9 @@ class DistributedOperator final : public CoupledOperator {
   void add_contact_forces(std::span<const Vec3> Xf);
   /// Forces at Xf, spreading and the fluid step into trial_ driven by F^{n+1/2} of (Xf, theta). Collective.
   void trial_step(std::span<const double> Xf, double theta, double dt);
+  /// The owned positions replaced by X, membranes migrated and U = J(X) u^n at the nodes owned then; no trial
+  /// left. Collective.
+  void move_to(std::span<const Vec3> X);
   /// chi_ at the midpoints (X^n + Xf)/2 of the owned membranes (with a viscosity contrast). Collective.
   void update_indicator(std::span<const Vec3> Xf);
 
