@@ -3,10 +3,11 @@
 //   - a 64×128×32 box with walls on y and z, periodic along x,
 // with 1 and 2 threads: BM_FluidStep the plain step(in, force, dt, out) (explicit schemes), BM_FluidTrial one trial
 // of an implicit step, step(prepared, force, out) after a prepare() made outside the timing (the trials of a step
-// share it). Counters: ratio_to_transforms = step time / time of the FFTW transforms alone that the step performs
-// (4 forward + 4 backward), speedup = (1-thread step time) / (this step time). Both times are the fastest of
-// several repetitions, taken alternately, so the ratio is robust to other processes sharing the machine (they
-// lengthen some repetitions, rarely all).
+// share it), BM_FluidEnergy the energy measures every accepted step takes (FluidEnergy.hpp; counter ratio_to_step:
+// their time over a plain step's). Counters: ratio_to_transforms = step time / time of the FFTW transforms alone that
+// the step performs (4 forward + 4 backward), speedup = (1-thread step time) / (this step time). Both times are the
+// fastest of several repetitions, taken alternately, so the ratio is robust to other processes sharing the machine
+// (they lengthen some repetitions, rarely all).
 #include <benchmark/benchmark.h>
 #include <omp.h>
 
@@ -15,9 +16,10 @@
 #include <chrono>
 #include <cmath>
 #include <map>
-#include <utility>
 #include <random>
+#include <utility>
 
+#include "immerse/fluid/FluidEnergy.hpp"
 #include "immerse/fluid/NavierStokesSolver.hpp"
 
 using namespace immerse;
@@ -89,6 +91,35 @@ void fluid_case(benchmark::State& state, bool trial) {
   state.SetLabel(which == 0 ? "64^3 periodic" : "64x128x32, walls y,z");
 }
 
+// The energy measures of a random field (the budget's pass over the grid after each accepted step), against a plain
+// step on the same grid.
+void BM_FluidEnergy(benchmark::State& state) {
+  const int which = static_cast<int>(state.range(0));
+  omp_set_num_threads(static_cast<int>(state.range(1)));
+  const Grid g = bench_grid(which);
+  FluidParams prm;
+  prm.mu = 0.01;
+  prm.body_force = {1, 0, 0};
+  prm.wall_upper[2] = {0.5, 0, 0};
+  NavierStokesSolver ns(g, prm, FftPlanning::Measure);
+  FluidState a = ns.initial_state(), b;
+  std::mt19937 rng(1);
+  std::uniform_real_distribution<double> U(-1, 1);
+  for (int d = 0; d < 3; ++d)
+    for (double& v : a.u[d].values()) v = U(rng);
+  ns.apply_wall_values(a.u);
+  const FaceField force(g);
+  ns.step(a, force, 1e-3, b);
+  for (auto _ : state) benchmark::DoNotOptimize(fluid_energy(g, prm, a.u, nullptr));
+  double energy = INFINITY, step = INFINITY;
+  for (int rep = 0; rep < 10; ++rep) {
+    energy = std::min(energy, seconds_of([&] { benchmark::DoNotOptimize(fluid_energy(g, prm, a.u, nullptr)); }));
+    step = std::min(step, seconds_of([&] { ns.step(a, force, 1e-3, b); }));
+  }
+  state.counters["ratio_to_step"] = energy / step;
+  state.SetLabel(which == 0 ? "64^3 periodic" : "64x128x32, walls y,z");
+}
+
 void BM_FluidStep(benchmark::State& state) { fluid_case(state, false); }
 void BM_FluidTrial(benchmark::State& state) { fluid_case(state, true); }
 
@@ -96,4 +127,5 @@ void BM_FluidTrial(benchmark::State& state) { fluid_case(state, true); }
 
 BENCHMARK(BM_FluidStep)->ArgsProduct({{0, 1}, {1, 2}})->ArgNames({"grid", "threads"})->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_FluidTrial)->ArgsProduct({{0, 1}, {1, 2}})->ArgNames({"grid", "threads"})->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_FluidEnergy)->ArgsProduct({{0, 1}, {1, 2}})->ArgNames({"grid", "threads"})->Unit(benchmark::kMillisecond);
 BENCHMARK_MAIN();

@@ -26,8 +26,10 @@ TEST(RbcChannel, ThirtyTwoCellsInAPoiseuilleDuctWithTheirDiagnostics) {
   const auto rows = read_csv(dir / "out" / "diagnostics.csv");
   ASSERT_EQ(rows.size(), 4u);  // header, steps 0, 1, 2
   const auto& head = rows[0];
-  EXPECT_EQ(head.back(), "mean_velocity");
-  EXPECT_EQ(head.size(), 8u + 32u * 12u + 1u);
+  // The membranes' columns, mean_velocity, then the energy budget (4 fluid columns, 3 per cell, 2 totals).
+  EXPECT_EQ(head[8u + 32u * 12u], "mean_velocity");
+  EXPECT_EQ(head.back(), "budget_residual");
+  EXPECT_EQ(head.size(), 8u + 32u * 12u + 1u + 4u + 32u * 3u + 2u);
   auto column = [&](const std::string& name) {
     const auto it = std::find(head.begin(), head.end(), name);
     EXPECT_NE(it, head.end()) << name;
@@ -56,6 +58,12 @@ TEST(RbcChannel, ThirtyTwoCellsInAPoiseuilleDuctWithTheirDiagnostics) {
   const DuctPoiseuille series{12e-6, 6e-6, 9e4, 4.1e-3};
   const double mean0 = std::stod(rows[1][column("mean_velocity")]), exact = series.flow_rate() / (24e-6 * 12e-6);
   EXPECT_NEAR(mean0 / exact, 1.0, 0.02) << mean0 << " vs " << exact;
+  // The body force drives the flow (no wall moves) and the fluid dissipates what it puts in, nearly all of it in the
+  // Poiseuille flow of step 0 (steady for the cell-free fluid).
+  EXPECT_EQ(std::stod(rows[1][column("P_walls")]), 0.0);
+  const double power = std::stod(rows[1][column("P_body")]), dissipation = std::stod(rows[1][column("dissipation")]);
+  EXPECT_GT(power, 0);
+  EXPECT_NEAR(dissipation / power, 1.0, 0.02);
   // The cells are carried downstream (+y) and add dissipation: the mean flow slows.
   EXPECT_GT(std::stod(rows[3][cell(12, "cy")]), centres[12].y);
   EXPECT_LT(std::stod(rows[3][column("mean_velocity")]), mean0);

@@ -63,6 +63,11 @@ class Module(unittest.TestCase):
         self.assertLess(np.abs(sim.positions() - X0).max(), 1e-12)
         self.assertLess(np.abs(sim.velocities()).max(), 1e-12)
         self.assertLess(abs(rows["volume"][-1] / rows["volume"][0] - 1), 1e-12)
+        # Nor energy: no kinetic energy, no strain at the reference shape (round-off of E_s times the area, 12.6 J),
+        # nothing to account for.
+        self.assertLess(np.abs(rows["E_kinetic"]).max(), 1e-24)
+        self.assertLess(np.abs(rows["E_elastic"]).max(), 1e-14)
+        self.assertLess(np.abs(rows["budget_residual"]).max(), 1e-24)
 
     def test_stepping_and_running_give_the_same_run(self):
         config = immerse.load(QUICK, set={"scenario.kt_end": 0.25})
@@ -76,6 +81,27 @@ class Module(unittest.TestCase):
         self.assertEqual(stepped[-1]["D_xz"], ran2["D_xz"][-1])
         self.assertGreater(stepped[-1]["D_xz"], 0)
         self.assertEqual(stepped[-1]["rejected"], 0)
+
+    def test_every_row_carries_the_energy_budget(self):
+        # The capsule in shear between sliding walls: the walls put power into the fluid, which dissipates it; the
+        # budget's residual is E_total - E_total(t0) + the trapezoidal integral of dissipation - P_walls - P_body.
+        sim = immerse.Simulation(immerse.load(QUICK, set={"scenario.kt_end": 0.25}))
+        rows = sim.run(steps=4)
+        units = sim.units
+        self.assertEqual([units[c] for c in ("E_kinetic", "dissipation", "P_walls", "P_body", "E_elastic",
+                                             "E_bending", "E_constraint", "E_total", "budget_residual")],
+                         ["J", "W", "W", "W", "J", "J", "J", "J", "J"])
+        self.assertEqual(sim.columns[-2:], ["E_total", "budget_residual"])
+        self.assertTrue(np.all(rows["P_walls"] > 0))
+        self.assertTrue(np.all(rows["dissipation"] > 0))
+        self.assertTrue(np.all(rows["P_body"] == 0))
+        np.testing.assert_allclose(rows["E_total"], rows["E_kinetic"] + rows["E_elastic"] + rows["E_bending"]
+                                   + rows["E_constraint"], rtol=1e-14)
+        rate = rows["dissipation"] - rows["P_walls"] - rows["P_body"]
+        integral = np.concatenate([[0.0], np.cumsum(0.5 * rows["dt"][1:] * (rate[1:] + rate[:-1]))])
+        expected = rows["E_total"] - rows["E_total"][0] + integral + rows["budget_residual"][0]
+        scale = np.abs(rows["P_walls"]).max() * rows["time"][-1]
+        np.testing.assert_allclose(rows["budget_residual"], expected, rtol=0, atol=1e-12 * scale)
 
     def test_applied_forces_move_the_membrane(self):
         sim = immerse.Simulation(immerse.load(SPHERE))

@@ -98,6 +98,13 @@ class OutputFiles(unittest.TestCase):
         unit = dict(zip(units["column"], units["unit"]))
         self.assertEqual((unit["time"], unit["m0_volume"], unit["m1_theta"]), ("s", "m^3", "rad"))
         np.testing.assert_allclose(rows["time"], [0.0, 0.02, 0.04, 0.06])
+        # The energy budget: the stretched capsule relaxes, the energy goes into the fluid and is dissipated.
+        self.assertEqual((unit["E_kinetic"], unit["dissipation"], unit["m1_E_elastic"], unit["budget_residual"]),
+                         ("J", "W", "J", "J"))
+        self.assertGreater(rows["m0_E_elastic"][0], 0)
+        self.assertTrue(np.all(np.diff(rows["E_total"]) < 0))
+        np.testing.assert_allclose(rows["E_total"], rows["E_kinetic"] + rows["m0_E_elastic"] + rows["m1_E_elastic"],
+                                   rtol=1e-14)
 
 
 class OutputFilesOverMpi(OutputFiles):
@@ -133,6 +140,11 @@ class OutputFilesOverMpi(OutputFiles):
                     self.assertLess(np.abs(mine[name] - theirs[name]).max() / scale, 1e-10, name)
                 self.assertEqual(a.attrs["xdmf_membranes"], b.attrs["xdmf_membranes"])
                 self.assertEqual(a.attrs["xdmf_fluid"], b.attrs["xdmf_fluid"])
+        # The energy columns: each process sums its slab's planes, added in plane order as one process does.
+        mine = np.genfromtxt(self.out / "diagnostics.csv", delimiter=",", names=True)
+        theirs = np.genfromtxt(self.serial / "diagnostics.csv", delimiter=",", names=True)
+        for name in ("E_kinetic", "dissipation", "m0_E_elastic", "m1_E_elastic", "E_total"):
+            np.testing.assert_allclose(mine[name], theirs[name], rtol=1e-10, err_msg=name)
         with h5py.File(self.out / "fields_000000.h5", "r") as a:
             self.assertEqual(a.attrs["threads"], "2 MPI processes, each with the OpenMP threads OMP_NUM_THREADS gives it")
 

@@ -4,6 +4,7 @@
 
 #include "immerse/app/Scenario.hpp"
 #include "immerse/app/ShearPlaneProfile.hpp"
+#include "immerse/io/TomlFormat.hpp"
 
 namespace immerse {
 
@@ -31,6 +32,21 @@ const std::vector<Column> kMembraneColumns{
     {"a3", "m", "semi-axis of the equivalent ellipsoid closest to z"},
     {"D_xz", "1", "Taylor deformation (L - B) / (L + B) of the section by the x-z plane through the centroid"},
     {"theta", "rad", "inclination of the longest principal axis to x in the x-z plane"}};
+// The energy budget (docs/energy-budget.md): the fluid's measures, each membrane's energies, then the run's totals.
+const std::vector<Column> kFluidEnergyColumns{
+    {"E_kinetic", "J", "kinetic energy of the fluid: rho/2 sum of u^2 h^3 over the velocity unknowns"},
+    {"dissipation", "W",
+     "viscous dissipation rate: mu sum of |G u|^2 h^3 (plus mu chi |S|^2/2 h^3 with a viscosity contrast)"},
+    {"P_walls", "W", "power the moving walls put into the fluid"},
+    {"P_body", "W", "power of the body force: f_body . sum of u h^3"}};
+const std::vector<Column> kMembraneEnergyColumns{{"E_elastic", "J", "in-plane elastic energy"},
+                                                 {"E_bending", "J", "bending energy (0 without one)"},
+                                                 {"E_constraint", "J", "energy of the volume and area constraints"}};
+const std::vector<Column> kBudgetColumns{
+    {"E_total", "J", "E_kinetic plus the energies of every membrane"},
+    {"budget_residual", "J",
+     "E_total - E_total(t0) + integral of dissipation - integral of (P_walls + P_body) (trapezoidal rule over every "
+     "step)"}};
 
 }  // namespace
 
@@ -39,15 +55,37 @@ Diagnostics::Diagnostics(const io::Config& config, std::size_t membranes, const 
   if (shear_rate_ > 0) columns_.insert(columns_.begin() + 2, kShearTime);
   auto per_membrane = kMembraneColumns;
   for (const auto& c : scenario.membrane_columns()) per_membrane.push_back(c);
-  for (std::size_t m = 0; m < membranes; ++m) {
-    std::string prefix, whose;
-    if (membranes > 1) {
-      prefix.append("m").append(std::to_string(m)).append("_");
-      whose = " of membrane[" + std::to_string(m) + "]";
+  const auto add_membranes = [&](const std::vector<Column>& columns) {
+    for (std::size_t m = 0; m < membranes; ++m) {
+      std::string prefix, whose;
+      if (membranes > 1) {
+        prefix.append("m").append(std::to_string(m)).append("_");
+        whose = " of membrane[" + std::to_string(m) + "]";
+      }
+      for (const auto& c : columns) columns_.push_back({prefix + c.name, c.unit, c.description + whose});
     }
-    for (const auto& c : per_membrane) columns_.push_back({prefix + c.name, c.unit, c.description + whose});
-  }
+  };
+  add_membranes(per_membrane);
   for (const auto& c : scenario.run_columns()) columns_.push_back(c);
+  columns_.insert(columns_.end(), kFluidEnergyColumns.begin(), kFluidEnergyColumns.end());
+  add_membranes(kMembraneEnergyColumns);
+  columns_.insert(columns_.end(), kBudgetColumns.begin(), kBudgetColumns.end());
+}
+
+void add_energy_values(const EnergyBudget& budget, std::span<const MembraneEnergyParts> membranes,
+                       std::vector<double>& row) {
+  const FluidEnergy& f = budget.fluid();
+  row.insert(row.end(), {f.kinetic, f.dissipation, f.walls, f.body});
+  for (const auto& m : membranes) row.insert(row.end(), {m.elastic, m.bending, m.constraint});
+  const double total = total_energy(f.kinetic, membranes);
+  row.insert(row.end(), {total, budget.residual(total)});
+}
+
+std::string energy_budget_note(const std::filesystem::path& checkpoint, long step, double time) {
+  return "# energy budget: " + checkpoint.string() +
+         " holds none (written before the budget was saved): the integrals of budget_residual start again at its "
+         "step " +
+         std::to_string(step) + ", t = " + io::format_number(time) + "\n";
 }
 
 // The semi-axes follow the coordinate axes, so that each column follows one axis of the shape in time (Figs. 4-5)
@@ -91,6 +129,9 @@ std::vector<double> Diagnostics::row(const Simulation& sim, const StepRecord& r)
     scenario_.add_membrane_values(X, row);
   }
   scenario_.add_run_values(sim, row);
+  std::vector<MembraneEnergyParts> energies;
+  for (std::size_t m = 0; m < sim.num_membranes(); ++m) energies.push_back(sim.membrane_energy(m));
+  add_energy_values(sim.energy_budget(), energies, row);
   return row;
 }
 

@@ -1,8 +1,12 @@
 #pragma once
 // The per-step diagnostics of a run: the rows of diagnostics.csv (step, time, solver counts, then per membrane its
-// volume, area, centroid, semi-axes, Taylor deformation D_xz and inclination, then the scenario's own columns).
-// Shared by `immerse run` and the Python module.
+// volume, area, centroid, semi-axes, Taylor deformation D_xz and inclination, then the scenario's own columns, then
+// the energy budget: the fluid's kinetic energy, dissipation and powers, each membrane's energies, the total energy
+// and the budget's residual, docs/energy-budget.md). Shared by `immerse run`, its distributed run and the Python
+// module.
 #include <array>
+#include <filesystem>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -29,6 +33,15 @@ class Diagnostics {
   double shear_rate_;
   std::vector<Column> columns_;
 };
+
+/// Appends the values of the energy columns (the last ones) for the budget of a run whose membranes have the
+/// energies `membranes`.
+void add_energy_values(const EnergyBudget& budget, std::span<const MembraneEnergyParts> membranes,
+                       std::vector<double>& row);
+
+/// The log line of a restart from a checkpoint without an energy budget (written before the budget existed): the
+/// integrals count from its step.
+std::string energy_budget_note(const std::filesystem::path& checkpoint, long step, double time);
 
 /// The principal semi-axes ordered by the coordinate axis their direction is closest to (a1 ~ x, a2 ~ y, a3 ~ z).
 std::array<double, 3> semi_axes_along_xyz(const MembraneGeometry& g);

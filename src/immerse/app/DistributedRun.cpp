@@ -168,6 +168,7 @@ io::ParallelCheckpoint checkpoint_of(const DistributedSimulation& sim) {
   put_history("integrator.guess_errors", sim.integrator().guess_errors().errors());
   ck.put_double("stepper.dt", sim.stepper().dt());
   ck.put_int("stepper.successes", sim.stepper().successes());
+  for (const auto& [name, value] : sim.energy_budget().entries()) ck.put_double(name, value);
   return ck;
 }
 
@@ -543,6 +544,7 @@ class DistributedLoop {
     const double mean_velocity = channel_ ? mean_velocity_y(sim_) : 0;
     const auto* suspension = dynamic_cast<const SuspensionShearRun*>(&scenario_);
     const auto stresses = suspension ? wall_stresses(sim_, *suspension) : std::pair<double, double>{};
+    const auto energies = sim_.membrane_energies();
     on_root([&] {
       std::vector<double> row{double(last_.step), last_.time};
       if (shear_rate_ > 0) row.push_back(shear_rate_ * last_.time);
@@ -560,6 +562,7 @@ class DistributedLoop {
       }
       if (channel_) row.push_back(mean_velocity);
       if (suspension) suspension->add_values(enclosed, stresses.first, stresses.second, row);
+      add_energy_values(sim_.energy_budget(), energies, row);
       root_->table().row(row);
     });
   }
@@ -663,6 +666,7 @@ int run_distributed(const RunOptions& options, std::ostream& out, std::ostream& 
   std::unique_ptr<ScenarioRun> scenario;
   std::optional<MeshCopies> copies;
   std::optional<RunSettings> settings;
+  bool budget_continued = true;
   std::string error;
   try {
     check_run_paths(options);
@@ -673,7 +677,11 @@ int run_distributed(const RunOptions& options, std::ostream& out, std::ostream& 
     check_process_count(config, processes);
     sim = std::make_unique<DistributedSimulation>(config, comm);
     scenario = make_scenario_run(config);
-    if (!options.restart.empty()) sim->restore(io::Checkpoint::read(options.restart));
+    if (!options.restart.empty()) {
+      const io::Checkpoint ck = io::Checkpoint::read(options.restart);
+      sim->restore(ck);
+      budget_continued = EnergyBudget::saved_in(ck);
+    }
     copies = MeshCopies::of(config);
   } catch (const InputError& e) {
     error = e.what();
@@ -689,6 +697,7 @@ int run_distributed(const RunOptions& options, std::ostream& out, std::ostream& 
   if (root) try {
       output = std::make_unique<RootOutput>(options, *sim, *settings, *scenario);
       output->create(*copies, provenance, *sim, processes, log);
+      if (!budget_continued) log << energy_budget_note(options.restart, sim->step(), sim->time()) << std::flush;
       if (const std::string warning = ThreadGovernor::oversubscription_warning(); !warning.empty())
         errors << "immerse: warning: " << warning << std::endl;
     } catch (const InputError& e) {

@@ -68,16 +68,18 @@ std::unique_ptr<Simulation> build_simulation(const io::Config& config) {
   }
 }
 
-// The scenario binds to the simulation before a restart restores both.
-void start_or_restore(Simulation& sim, ScenarioRun& scenario, const std::filesystem::path& restart) {
+// The scenario binds to the simulation before a restart restores both. Returns false for a checkpoint without an
+// energy budget (the budget's integrals then start at its state).
+bool start_or_restore(Simulation& sim, ScenarioRun& scenario, const std::filesystem::path& restart) {
   scenario.attach(sim);
   if (restart.empty()) {
     scenario.start(sim);
-    return;
+    return true;
   }
   const io::Checkpoint ck = io::Checkpoint::read(restart);
   sim.restore(ck);
   scenario.restore(ck, sim);
+  return EnergyBudget::saved_in(ck);
 }
 
 void print_summary(const Simulation& sim, const TimeLoop& loop, int status, std::ostream& out) {
@@ -140,7 +142,7 @@ int run_command(const RunOptions& options, std::ostream& out, std::ostream& err)
     return 4;
   }
   const std::unique_ptr<ScenarioRun> scenario = make_scenario_run(config);
-  start_or_restore(*sim, *scenario, options.restart);
+  const bool budget_continued = start_or_restore(*sim, *scenario, options.restart);
   const MeshCopies copies = MeshCopies::of(config);
   // 2. The output folder: may this run take it, and which rows of a run it continues stay.
   RunOutput output(options, *sim, settings, *scenario);
@@ -148,6 +150,7 @@ int run_command(const RunOptions& options, std::ostream& out, std::ostream& err)
     err << "immerse: warning: " << warning << std::endl;
   // 3. The first files, then the time loop with its output on schedules.
   output.create(copies, out);
+  if (!budget_continued) out << energy_budget_note(options.restart, sim->step(), sim->time()) << std::flush;
   scenario->announce(out);
   TimeLoop loop(*sim, *scenario, output, settings, out, err);
   const int status = loop.run();

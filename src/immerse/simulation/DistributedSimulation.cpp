@@ -45,6 +45,47 @@ DistributedSimulation::DistributedSimulation(const io::Config& config, Communica
   integrator_ = make_integrator(config_.get<std::string>("time.scheme"), run_solver_settings(config_),
                                 comm.comm());
   integrator_->prepare(op_->size());
+  start_budget();
+}
+
+FluidEnergy DistributedSimulation::fluid_energy() const {
+  const SlabDecomposition& slabs = fluid_.decomposition();
+  const Array3& chi = op_->viscosity_indicator();
+  const PlaneRange cells = slabs.cells();
+  const std::vector<double> mine =
+      fluid_energy_planes(grid_, fluid_.params(), op_->fluid_state().u, chi.size() > 0 ? &chi : nullptr, cells.begin,
+                          cells.end, slabs.offset());
+  return fluid_energy_total(grid_, fluid_.params(), slabs.communicator().sum(mine));
+}
+
+std::vector<MembraneEnergyParts> DistributedSimulation::membrane_energies() const {
+  // Each membrane's energies from its owner, zeros elsewhere: the sum over the processes is exact.
+  const std::size_t M = num_membranes();
+  std::vector<double> mine(3 * M, 0.0);
+  std::string error;
+  for (const OwnedMembrane& o : op_->ownership().owned()) {
+    const auto m = static_cast<std::size_t>(o.id);
+    try {
+      const MembraneEnergyParts e = membrane_energy(*membranes_.membranes[m], o.positions);
+      mine[3 * m] = e.elastic;
+      mine[3 * m + 1] = e.bending;
+      mine[3 * m + 2] = e.constraint;
+    } catch (const SimulationError& e) {
+      if (error.empty()) error = "membrane[" + std::to_string(m) + "] " + e.what();
+    }
+  }
+  const Communicator& comm = fluid_.decomposition().communicator();
+  if (const std::string first = first_error(comm, error); !first.empty()) throw SimulationError(first);
+  const std::vector<double> all = comm.sum(mine);
+  std::vector<MembraneEnergyParts> parts(M);
+  for (std::size_t m = 0; m < M; ++m) parts[m] = {all[3 * m], all[3 * m + 1], all[3 * m + 2]};
+  return parts;
+}
+
+void DistributedSimulation::start_budget() {
+  const std::vector<MembraneEnergyParts> parts = membrane_energies();
+  const FluidEnergy fluid = fluid_energy();
+  budget_.start(total_energy(fluid.kinetic, parts), fluid);
 }
 
 bool DistributedSimulation::finished() const { return time() >= end_time_ * (1 - 1e-12); }
@@ -75,8 +116,9 @@ StepRecord DistributedSimulation::advance(const std::function<void(const std::st
   ++step_;
   r.step = step_;
   r.time = time();
-  r.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   check_stability();
+  budget_.advance(r.dt, fluid_energy());
+  r.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return r;
 }
 
@@ -249,6 +291,7 @@ void DistributedSimulation::restore(const io::Checkpoint& ck) {
                            guess_errors.size() / std::max<std::size_t>(unknowns, 1));
   stepper_.set_state(dt, static_cast<int>(successes));
   step_ = step;
+  if (!budget_.restore(ck)) start_budget();
 }
 
 }  // namespace immerse

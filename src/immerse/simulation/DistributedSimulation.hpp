@@ -41,6 +41,7 @@
 #include "immerse/io/Config.hpp"
 #include "immerse/parallel/Communicator.hpp"
 #include "immerse/simulation/DistributedOperator.hpp"
+#include "immerse/simulation/EnergyBudget.hpp"
 #include "immerse/simulation/MembraneSet.hpp"
 #include "immerse/simulation/StepRecord.hpp"
 #include "immerse/timestep/AdaptiveStepper.hpp"
@@ -56,10 +57,10 @@ class DistributedSimulation {
   DistributedSimulation(const DistributedSimulation&) = delete;
   DistributedSimulation& operator=(const DistributedSimulation&) = delete;
 
-  /// Advances one accepted step, as Simulation::advance: an implicit step whose solve fails is halved and retried
-  /// (AdaptiveStepper; each rejection reported through `log`, on every process). SimulationError on every process
-  /// when the run becomes unstable (a node not finite or faster than time.max_speed, a membrane failing) or the
-  /// halved step would fall below time.dt_min (naming step, time and why). Collective.
+  /// Advances one accepted step, as Simulation::advance (energy budget included): an implicit step whose solve fails
+  /// is halved and retried (AdaptiveStepper; each rejection reported through `log`, on every process). SimulationError
+  /// on every process when the run becomes unstable (a node not finite or faster than time.max_speed, a membrane
+  /// failing) or the halved step would fall below time.dt_min (naming step, time and why). Collective.
   StepRecord advance(const std::function<void(const std::string&)>& log = {});
   bool finished() const;
 
@@ -85,11 +86,20 @@ class DistributedSimulation {
   const MembraneIntegrator& integrator() const { return *integrator_; }
   /// The step control (the current step and the accepted steps since it was last changed), saved in checkpoints.
   const AdaptiveStepper& stepper() const { return stepper_; }
+  /// The energy budget, as Simulation's, the same on every process (its entries go into checkpoints).
+  const EnergyBudget& energy_budget() const { return budget_; }
+  /// The fluid measures of the committed state: each process sums its own planes, and the plane sums of all are
+  /// added in plane order, so that they equal one process's to round-off of the fields. Collective.
+  FluidEnergy fluid_energy() const;
+  /// The energies of every membrane at its committed positions, from the processes owning them, on every process.
+  /// SimulationError on every process if a membrane's cannot be evaluated. Collective.
+  std::vector<MembraneEnergyParts> membrane_energies() const;
 
   /// Continues from a checkpoint of the same configuration written by any number of processes (or by Simulation):
   /// every process passes the whole checkpoint; the fluid is cut into this run's slabs and the membranes are owned
   /// by the processes holding their centroids. The integrator history (previous positions and guess errors, per node
-  /// in global membrane order) is taken for the owned nodes. InputError as Simulation::restore. Collective.
+  /// in global membrane order) is taken for the owned nodes, and the energy budget as Simulation::restore does.
+  /// InputError as Simulation::restore. Collective.
   void restore(const io::Checkpoint& ck);
 
  private:
@@ -99,6 +109,8 @@ class DistributedSimulation {
   /// After a migration: the integrator's history of the membranes (X^{n-1}, the guess errors) moved along, so that
   /// each membrane's initial guess is the one-process run's. Collective.
   void follow_history();
+  /// Starts the energy budget at the committed state (every membrane's energy from its owner). Collective.
+  void start_budget();
 
   io::Config config_;
   double end_time_, max_speed_;
@@ -109,6 +121,7 @@ class DistributedSimulation {
   std::unique_ptr<DistributedOperator> op_;
   std::unique_ptr<MembraneIntegrator> integrator_;
   AdaptiveStepper stepper_;
+  EnergyBudget budget_;
   long step_ = 0;
 };
 

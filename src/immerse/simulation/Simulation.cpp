@@ -54,6 +54,23 @@ Simulation::Simulation(const io::Config& config, const std::function<bool()>& st
                      std::to_string(DenseBfgs::max_unknowns) + " unknowns and this run has " +
                      std::to_string(op_->size()) + " (use \"jfnk\", \"anderson\" or \"lbfgs\")");
   integrator_->prepare(op_->size());
+  start_budget();
+}
+
+FluidEnergy Simulation::fluid_energy() const {
+  const Array3& chi = op_->viscosity_indicator();
+  return immerse::fluid_energy(grid_, fluid_.params(), op_->fluid_state().u, chi.size() > 0 ? &chi : nullptr);
+}
+
+MembraneEnergyParts Simulation::membrane_energy(std::size_t m) const {
+  return immerse::membrane_energy(*membranes_[m], op_->membrane_positions(m));
+}
+
+void Simulation::start_budget() {
+  std::vector<MembraneEnergyParts> parts;
+  for (std::size_t m = 0; m < num_membranes(); ++m) parts.push_back(membrane_energy(m));
+  const FluidEnergy fluid = fluid_energy();
+  budget_.start(total_energy(fluid.kinetic, parts), fluid);
 }
 
 bool Simulation::finished() const { return time() >= end_time_ * (1 - 1e-12); }
@@ -88,8 +105,9 @@ StepRecord Simulation::advance(const std::function<void(const std::string&)>& lo
   ++step_;
   r.step = step_;
   r.time = time();
-  r.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   check_stability(r);
+  budget_.advance(r.dt, fluid_energy());
+  r.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return r;
 }
 
@@ -172,6 +190,7 @@ io::Checkpoint Simulation::checkpoint() const {
   ck.put_array("integrator.guess_errors", integrator_->guess_errors().errors());
   ck.put_double("stepper.dt", stepper_.dt());
   ck.put_int("stepper.successes", stepper_.successes());
+  for (const auto& [name, value] : budget_.entries()) ck.put_double(name, value);
   return ck;
 }
 
@@ -243,6 +262,7 @@ void Simulation::restore(const io::Checkpoint& ck) {
   integrator_->set_history(prev_X, prev_dt, guess_errors);
   stepper_.set_state(dt, static_cast<int>(successes));
   step_ = step;
+  if (!budget_.restore(ck)) start_budget();
 }
 
 }  // namespace immerse

@@ -15,6 +15,7 @@
 #include "immerse/io/Config.hpp"
 #include "immerse/membrane/ElasticMembrane.hpp"
 #include "immerse/membrane/Mesh.hpp"
+#include "immerse/simulation/EnergyBudget.hpp"
 #include "immerse/simulation/ImmersedBoundaryOperator.hpp"
 #include "immerse/simulation/StepRecord.hpp"
 #include "immerse/timestep/AdaptiveStepper.hpp"
@@ -30,8 +31,9 @@ class Simulation {
   explicit Simulation(const io::Config& config, const std::function<bool()>& stop_requested = {});
 
   /// Advances one accepted step (with step halving on failed solves, reported through `log`), then corrects the
-  /// volume of the membranes with volume_correction = "normal_shift" (VolumeCorrection.hpp). Throws
-  /// SimulationError naming step, time, membrane and quantity when the run becomes unstable.
+  /// volume of the membranes with volume_correction = "normal_shift" (VolumeCorrection.hpp), and adds the step to
+  /// the energy budget (EnergyBudget.hpp). Throws SimulationError naming step, time, membrane and quantity when the
+  /// run becomes unstable.
   /// `stop_requested` is asked after each rejected attempt (StopRequested is thrown when it returns true).
   StepRecord advance(const std::function<void(const std::string&)>& log,
                      const std::function<bool()>& stop_requested = {});
@@ -49,17 +51,28 @@ class Simulation {
   const ElasticMembrane& membrane(std::size_t m) const { return *membranes_[m]; }
   const std::vector<Vec3>& reference(std::size_t m) const { return references_[m]; }
 
+  /// The energy budget: the fluid measures of the last state and the integrals since the start of the run (they
+  /// continue across restarts), updated by advance().
+  const EnergyBudget& energy_budget() const { return budget_; }
+  /// The fluid measures of the committed state, with the viscosity of the last step (FluidEnergy.hpp).
+  FluidEnergy fluid_energy() const;
+  /// The energies of membrane m at its committed positions.
+  MembraneEnergyParts membrane_energy(std::size_t m) const;
+
   /// External nodal forces on membrane m (see ImmersedBoundaryOperator::set_applied_forces).
   void set_applied_forces(std::size_t m, const std::vector<Vec3>& F) { op_->set_applied_forces(m, F); }
 
   /// Everything needed to continue bitwise identically.
   io::Checkpoint checkpoint() const;
   /// Continues from a checkpoint of the same configuration (InputError naming the first differing key otherwise;
-  /// time.end and output.* may differ).
+  /// time.end and output.* may differ). A checkpoint without an energy budget (EnergyBudget::saved_in) starts the
+  /// budget's integrals at its state.
   void restore(const io::Checkpoint& ck);
 
  private:
   void check_stability(const StepRecord& r) const;
+  /// Starts the energy budget at the committed state.
+  void start_budget();
 
   io::Config config_;
   double end_time_;   ///< time.end and time.max_speed, read once (the run's configuration does not change)
@@ -77,6 +90,7 @@ class Simulation {
   std::unique_ptr<ImmersedBoundaryOperator> op_;
   std::unique_ptr<MembraneIntegrator> integrator_;
   AdaptiveStepper stepper_;
+  EnergyBudget budget_;
   long step_ = 0;
   std::string packing_summary_;
 };
