@@ -36,12 +36,16 @@ void GuessErrorPredictor::update_grams(const std::vector<std::size_t>& b) const 
   gram_rows_ = m;
 }
 
-GuessErrorPredictor::Fit GuessErrorPredictor::fit(const Gram& G, std::size_t m, std::size_t unknowns) {
-  if (m < 2) return {};
-  for (int t = static_cast<int>(std::min<std::size_t>(kMaxTerms, m - 1)); t >= 1; --t) {
+GuessErrorPredictor::Fit GuessErrorPredictor::fit(const Gram& G, std::size_t m, std::size_t unknowns, double floor2) {
+  std::size_t first = 0;  // the errors it may use: e_[first .. m), all above the floor
+  for (std::size_t j = 0; j < m; ++j)
+    if (!(G[j][j] > floor2)) first = j + 1;
+  const std::size_t usable = m - first;
+  if (usable < 2) return {};
+  for (int t = static_cast<int>(std::min<std::size_t>(kMaxTerms, usable - 1)); t >= 1; --t) {
     // Normal equations of e_[j] ~ sum_p a_p e_[j-1-p] over the targets j = m-w .. m-1; more equations than terms,
     // or the fit would be exact whatever the errors.
-    const std::size_t w = std::min<std::size_t>(kWindow, m - static_cast<std::size_t>(t));
+    const std::size_t w = std::min<std::size_t>(kWindow, usable - static_cast<std::size_t>(t));
     if (w * unknowns <= static_cast<std::size_t>(t)) continue;
     std::array<double, kMaxTerms * kMaxTerms> N{};
     std::array<double, kMaxTerms> b{};
@@ -53,7 +57,6 @@ GuessErrorPredictor::Fit GuessErrorPredictor::fit(const Gram& G, std::size_t m, 
         for (int q = 0; q < t; ++q) N[p * kMaxTerms + q] += G[j - 1 - p][j - 1 - q];
       }
     }
-    if (yy == 0) continue;
     // A squared pivot below 1e-8 of its diagonal entry (the new error's sine to the span of the others below 1e-4)
     // means the errors are dependent: a term less.
     if (!cholesky_factor(N.data(), t, kMaxTerms, [](double pivot, double diagonal) { return pivot > 1e-8 * diagonal; }))
@@ -69,10 +72,10 @@ GuessErrorPredictor::Fit GuessErrorPredictor::fit(const Gram& G, std::size_t m, 
   return {};
 }
 
-GuessErrorPredictor::Fit GuessErrorPredictor::next_fit(const Gram& G, std::size_t unknowns) const {
+GuessErrorPredictor::Fit GuessErrorPredictor::next_fit(const Gram& G, std::size_t unknowns, double floor2) const {
   const std::size_t m = e_.size();
   if (m >= 3) {  // did the fit one step earlier, applied to e_[m-2], e_[m-3], ..., predict e_[m-1]?
-    if (const Fit last = fit(G, m - 1, unknowns); last.terms > 0) {
+    if (const Fit last = fit(G, m - 1, unknowns, floor2); last.terms > 0) {
       const std::size_t y = m - 1;
       double miss = G[y][y];
       for (int p = 0; p < last.terms; ++p) {
@@ -82,7 +85,27 @@ GuessErrorPredictor::Fit GuessErrorPredictor::next_fit(const Gram& G, std::size_
       if (miss > G[y][y]) return {};
     }
   }
-  return fit(G, m, unknowns);
+  return fit(G, m, unknowns, floor2);
+}
+
+GuessErrorPredictor::Fit GuessErrorPredictor::trusted_fit(std::size_t k, const std::vector<std::size_t>& b,
+                                                          std::span<const double> positions,
+                                                          std::span<const double> X) const {
+  double xx = 0, dd = 0;  // ||X^n||^2 and the squared displacement of the extrapolation, over the block
+  for (std::size_t i = b[k]; i < b[k + 1]; ++i) {
+    xx += positions[i] * positions[i];
+    dd += (X[i] - positions[i]) * (X[i] - positions[i]);
+  }
+  const Gram& G = grams_[k];
+  const Fit f = next_fit(G, b[k + 1] - b[k], kResolved * kResolved * xx);
+  if (f.terms == 0) return f;
+  const std::size_t m = e_.size();
+  double pp = 0;  // ||a1 e_[m-1] + ... + at e_[m-t]||^2
+  for (int p = 0; p < f.terms; ++p)
+    for (int q = 0; q < f.terms; ++q) pp += f.a[p] * f.a[q] * G[m - 1 - p][m - 1 - q];
+  const double recent = std::max(G[m - 1][m - 1], G[m - 2][m - 2]);  // a fit has at least two errors
+  if (pp > kBound * kBound * recent || pp > kBound * kBound * dd) return {};
+  return f;
 }
 
 std::vector<std::size_t> GuessErrorPredictor::blocks(std::span<const std::size_t> offsets) const {
@@ -93,25 +116,33 @@ std::vector<std::size_t> GuessErrorPredictor::blocks(std::span<const std::size_t
   return {offsets.begin(), offsets.end()};
 }
 
-int GuessErrorPredictor::terms(double dt, std::span<const std::size_t> offsets) const {
+void GuessErrorPredictor::check(std::span<const double> positions, std::span<const double> X) const {
+  if (X.size() != e_.back().size() || positions.size() != X.size())
+    throw std::logic_error("GuessErrorPredictor: the number of unknowns changed");
+}
+
+int GuessErrorPredictor::terms(double dt, std::span<const double> positions, std::span<const double> X,
+                               std::span<const std::size_t> offsets) const {
   if (dt != dt_ || e_.empty()) return 0;
+  check(positions, X);
   const auto b = blocks(offsets);
   update_grams(b);
   int most = 0;
-  for (std::size_t k = 0; k + 1 < b.size(); ++k) most = std::max(most, next_fit(grams_[k], b[k + 1] - b[k]).terms);
+  for (std::size_t k = 0; k + 1 < b.size(); ++k) most = std::max(most, trusted_fit(k, b, positions, X).terms);
   return most;
 }
 
-void GuessErrorPredictor::predict(double dt, std::span<double> X, std::span<const std::size_t> offsets) const {
+void GuessErrorPredictor::predict(double dt, std::span<const double> positions, std::span<double> X,
+                                  std::span<const std::size_t> offsets) const {
   if (dt != dt_ || e_.empty()) return;
-  if (X.size() != e_.back().size()) throw std::logic_error("GuessErrorPredictor: the number of unknowns changed");
+  check(positions, X);
   const auto b = blocks(offsets);
   update_grams(b);
   const std::size_t m = e_.size(), nblocks = b.size() - 1;
   // Blocks (membranes) in parallel, each summed in order: the prediction does not depend on the thread count.
 #pragma omp parallel for schedule(dynamic) if (nblocks > 1 && long(X.size()) >= kMinValuesForThreads)
   for (std::size_t k = 0; k < nblocks; ++k) {
-    const Fit f = next_fit(grams_[k], b[k + 1] - b[k]);
+    const Fit f = trusted_fit(k, b, positions, X);
     for (int p = 0; p < f.terms; ++p)
       for (std::size_t i = b[k]; i < b[k + 1]; ++i) X[i] += f.a[p] * e_[m - 1 - p][i];
   }

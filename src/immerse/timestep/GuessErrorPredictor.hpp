@@ -19,12 +19,28 @@
 // above 1/2; the fit needs more equations than terms), or when the same fit one step earlier (recomputed from the
 // stored errors, whether or not it was used) would have missed e^n by more than e^n itself (the recurrence stopped
 // holding: the extrapolation alone was better). The history is dropped when dt changes (the errors scale with it).
-// Measured on §4.4 (docs/time-integration.md).
-// Verified by the tests GuessErrorPredictor.* (known recurrences predicted exactly, the history rules, fewer fluid
-// solves for the same JFNK steps).
+//
+// Two rules keep the guess from moving further than the errors justify (norms over the block):
+// - Resolution. An error is computed from positions, to their round-off (~1e-16 ||X||); a fit uses only the errors
+//   after the last one not above kResolved ||X^n|| = 1e4 eps ||X^n||. The dependence test above is relative to each
+//   error's own size: a round-off-sized error passes it as independent, and least squares gives it a coefficient as
+//   large as the ratio of the sizes, which the prediction then applies to a larger error. A red cell at rest records
+//   such errors (round-off where Newton accepts an unpredicted X^(0) at once, ~1e-8 ||X|| elsewhere), and its guesses
+//   were moved by up to 4 % of ||X||.
+// - Size. Under (29) |r| <= 1 for every mode: no mode's share of the errors grows from one step to the next, nor its
+//   share of the displacement d^n = X^n - X^{n-1} (X - X^n on entry to predict), so e^{n+1} = d^{n+1} - d^n stays
+//   below 2 ||d^n|| (a mode ringing at r = -1). A prediction larger than kBound = 2 times the larger of ||e^n|| and
+//   ||e^{n-1}||, or than 2 ||d^n||, is refused: Newton starts from the extrapolation. It catches fits to errors that
+//   are resolved but do not follow the modes (at rest, errors at the Newton tolerance, many of them earlier
+//   predictions accepted as they were, are nearly dependent). On the quick §4.4 channel the predictions stay below
+//   1.09 times the larger of the last two errors and 0.05 ||d^n||.
+// Measured on §4.4 and on a red cell at rest (docs/time-integration.md).
+// Verified by the tests GuessErrorPredictor.* (known recurrences predicted exactly, the history rules, the
+// resolution and size rules, fewer fluid solves for the same JFNK steps, the cell at rest).
 #include <array>
 #include <cstddef>
 #include <deque>
+#include <limits>
 #include <span>
 #include <vector>
 
@@ -35,12 +51,20 @@ class GuessErrorPredictor {
  public:
   static constexpr int kMaxTerms = 5;
   static constexpr int kWindow = 2;  ///< errors each fit is fitted to
+  /// A fit uses only errors above kResolved ||X^n|| (over their block): far above the round-off of the positions.
+  static constexpr double kResolved = 1e4 * std::numeric_limits<double>::epsilon();
+  /// A prediction larger than kBound times the larger of the last two errors, or than kBound times the displacement
+  /// of the extrapolation, is refused.
+  static constexpr double kBound = 2;
 
+  /// Adds to X, the linear extrapolation of the positions X^n (`positions`) over a step dt, the error predicted for
+  /// it in each block where a recurrence holds and its prediction is trusted (the rules above; nothing elsewhere).
   /// `offsets` splits the unknowns into blocks fitted separately (block b is [offsets[b], offsets[b+1]); empty: one).
-  /// The largest number of terms a block's next prediction uses (0: no block predicts).
-  int terms(double dt, std::span<const std::size_t> offsets = {}) const;
-  /// Adds the predicted error of a step of length dt to X (nothing where no recurrence holds).
-  void predict(double dt, std::span<double> X, std::span<const std::size_t> offsets = {}) const;
+  void predict(double dt, std::span<const double> positions, std::span<double> X,
+               std::span<const std::size_t> offsets = {}) const;
+  /// The largest number of terms a block's prediction with these arguments uses (0: no block predicts).
+  int terms(double dt, std::span<const double> positions, std::span<const double> X,
+            std::span<const std::size_t> offsets = {}) const;
   /// Records the error of a step of length dt that started from the linear extrapolation.
   void record(double dt, std::span<const double> error);
   void clear();
@@ -66,10 +90,15 @@ class GuessErrorPredictor {
   // the errors before it are computed once, when it is first needed, and kept while both stay stored (each sum in
   // the order of the unknowns, so the entries do not depend on when they were computed or on the thread count).
   void update_grams(const std::vector<std::size_t>& b) const;
-  // The fit that predicts e_[m] from e_[m-1], e_[m-2], ... (m <= number stored) in a block of `unknowns`.
-  static Fit fit(const Gram& G, std::size_t m, std::size_t unknowns);
+  // The fit that predicts e_[m] from e_[m-1], e_[m-2], ... (m <= number stored) in a block of `unknowns`, using
+  // only the errors after the last one whose squared norm is not above floor2.
+  static Fit fit(const Gram& G, std::size_t m, std::size_t unknowns, double floor2);
   // The fit for the next error in a block, or none (the rules above).
-  Fit next_fit(const Gram& G, std::size_t unknowns) const;
+  Fit next_fit(const Gram& G, std::size_t unknowns, double floor2) const;
+  // next_fit for block k on its resolved errors, or none where its prediction exceeds the bounds.
+  Fit trusted_fit(std::size_t k, const std::vector<std::size_t>& b, std::span<const double> positions,
+                  std::span<const double> X) const;
+  void check(std::span<const double> positions, std::span<const double> X) const;
   std::vector<std::size_t> blocks(std::span<const std::size_t> offsets) const;
   std::deque<std::vector<double>> e_;
   double dt_ = 0;

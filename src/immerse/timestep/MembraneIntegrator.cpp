@@ -48,7 +48,7 @@ void MembraneIntegrator::initial_guess(const ThetaResidual& g, SolverSettings::I
     return;
   extrapolated_.assign(X0.begin(), X0.end());
   extrapolated_valid_ = true;
-  errors_.predict(g.dt(), X0, g.op().membrane_offsets());
+  errors_.predict(g.dt(), g.op().positions(), X0, g.op().membrane_offsets());
 }
 
 void MembraneIntegrator::remember(const CoupledOperator& op, double dt, std::span<const double> X) {
