@@ -72,7 +72,7 @@ Diagnostics::Diagnostics(const io::Config& config, std::size_t membranes, const 
   columns_.insert(columns_.end(), kBudgetColumns.begin(), kBudgetColumns.end());
 }
 
-void add_energy_values(const EnergyBudget& budget, std::span<const MembraneEnergyParts> membranes,
+void add_energy_values(const EnergyBudget& budget, std::span<const MembraneEnergy> membranes,
                        std::vector<double>& row) {
   const FluidEnergy& f = budget.fluid();
   row.insert(row.end(), {f.kinetic, f.dissipation, f.walls, f.body});
@@ -129,7 +129,7 @@ std::vector<double> Diagnostics::row(const Simulation& sim, const StepRecord& r)
     scenario_.add_membrane_values(X, row);
   }
   scenario_.add_run_values(sim, row);
-  std::vector<MembraneEnergyParts> energies;
+  std::vector<MembraneEnergy> energies;
   for (std::size_t m = 0; m < sim.num_membranes(); ++m) energies.push_back(sim.membrane_energy(m));
   add_energy_values(sim.energy_budget(), energies, row);
   return row;

@@ -36,7 +36,7 @@ class Diagnostics {
 
 /// Appends the values of the energy columns (the last ones) for the budget of a run whose membranes have the
 /// energies `membranes`.
-void add_energy_values(const EnergyBudget& budget, std::span<const MembraneEnergyParts> membranes,
+void add_energy_values(const EnergyBudget& budget, std::span<const MembraneEnergy> membranes,
                        std::vector<double>& row);
 
 /// The log line of a restart from a checkpoint without an energy budget (written before the budget existed): the

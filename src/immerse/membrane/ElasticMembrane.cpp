@@ -210,7 +210,8 @@ ElasticMembrane::ElasticMembrane(const Mesh& mesh, std::vector<Vec3> reference, 
     }
   }
   threaded_ = static_cast<long>(E) >= kMinElementsForThreads;
-  if (bending_.kappa_B > 0) fit_.emplace(mesh, reference_);
+  if (bending_.kappa_B > 0) bending_energy_.emplace(mesh, reference_, bending_, threaded_);
+  if (bending_.kappa_B > 0 && method_ == ForceMethod::Contour) fit_.emplace(mesh, reference_);
   kappa_ref_ = fit_ && bending_.reference == ReferenceCurvature::RestShape ? reference_mean_curvature()
                                                                           : std::vector<double>(N, 0.0);
   if (constraint.volume != 0 || constraint.area != 0) constraint_.emplace(mesh, mesh.nodes, constraint);
@@ -387,11 +388,12 @@ void ElasticMembrane::compute_force(std::span<const Vec3> X, std::vector<Vec3>& 
   Work& w = workspace();
   const bool energy = method_ == ForceMethod::Energy;
   const bool bending = bending_.kappa_B > 0;
-  if (energy) energy_forces(X, w);
-  if (!energy || bending) {
-    node_pass(X, !energy, w);
+  if (energy) {
+    energy_forces(X, w);
+  } else {
+    node_pass(X, true, w);
     if (bending) bending_passes(X, w);
-    contour_forces(X, !energy, bending, w);
+    contour_forces(X, true, bending, w);
   }
   // Node i collects its share of every element's force, slots in ascending element order.
   const int N = static_cast<int>(num_nodes());
@@ -401,16 +403,20 @@ void ElasticMembrane::compute_force(std::span<const Vec3> X, std::vector<Vec3>& 
     Vec3 s;
     for (int j = inc_start_[i]; j < inc_start_[i + 1]; ++j) {
       const int slot = inc_[j], e = slot / 6, k = slot % 6;
-      if (!energy)
-        s += w.el_frac[e][k] * w.el_force[e];
-      else if (bending)
-        s += w.en_force[slot] + w.el_frac[e][k] * w.el_force[e];
-      else
-        s += w.en_force[slot];
+      s += energy ? w.en_force[slot] : w.el_frac[e][k] * w.el_force[e];
     }
     F[i] = s;
   }
+  if (energy && bending) bending_energy_->add_force(X, F);
   if (constraint_) constraint_->add_force(X, F);
+}
+
+MembraneEnergy ElasticMembrane::energy_parts(std::span<const Vec3> X) const {
+  MembraneEnergy e;
+  e.elastic = compute_energy(X);
+  if (bending_energy_) e.bending = bending_energy_->energy(X);
+  if (constraint_) e.constraint = constraint_->energy(X);
+  return e;
 }
 
 
@@ -525,13 +531,12 @@ std::size_t ElasticMembrane::memory_bytes() const {
   // Workspace of compute_force (kept per calling thread): per node and per element node n, and tau (eq. 42
   // tension) or N, kappa, m and q (bending); per element F_e and the lumping fractions (eq. 42); the energy
   // method's per-element-node forces.
-  const bool bending = bending_.kappa_B > 0, energy = method_ == ForceMethod::Energy;
-  const std::size_t work = (energy && !bending ? 0 : (N + 6 * E) * sizeof(Vec3)) +
-                           (energy ? 0 : (N + 6 * E) * sizeof(membrane_k::SymTensor)) +
-                           (bending ? N * 2 * (sizeof(Mat3) + sizeof(Vec3)) : 0) +
-                           (energy && !bending ? 0 : E * (sizeof(Vec3) + sizeof(std::array<double, 6>))) +
-                           (energy ? 6 * E * sizeof(Vec3) : 0);
-  return persistent + work;
+  const bool energy = method_ == ForceMethod::Energy, fit = fit_.has_value();
+  const std::size_t work = (energy ? 6 * E * sizeof(Vec3)
+                                   : (N + 6 * E) * (sizeof(Vec3) + sizeof(membrane_k::SymTensor)) +
+                                         E * (sizeof(Vec3) + sizeof(std::array<double, 6>))) +
+                           (fit ? N * 2 * (sizeof(Mat3) + sizeof(Vec3)) : 0);
+  return persistent + work + (bending_energy_ ? bending_energy_->memory_bytes() : 0);
 }
 
 }  // namespace immerse

@@ -9,9 +9,10 @@
 //                         (3-point Gauss on each quadratic edge), with tau, q, n interpolated from nodal values
 //                         that are averages over the elements sharing a node. F_e = S_e fbar_e is then shared
 //                         among the element's six nodes in proportion to their lumped areas (node_area).
-//   ForceMethod::Energy   F_i = -dE/dX_i of E = sum_e sum_gp W(A1, A2) Jbar w (6-point rule on each curved
-//                         element, A from the element's own interpolation): exact linear and angular momentum.
-//                         Bending (if kappa_B > 0) is added as the q-part of eq. (42); E holds no bending energy.
+//   ForceMethod::Energy   F_i = -dE/dX_i of E = sum_e sum_gp W(A1, A2) Jbar w + E_B (6-point rule on each curved
+//                         element, A from the element's own interpolation; E_B the discrete mean-curvature energy
+//                         of MeanCurvatureBending): exact linear and angular momentum, and an implicit step that
+//                         cannot create energy (docs/energy-budget.md).
 // Optionally the global volume and area constraints of VolumeAreaConstraint are added to either (exact -dE/dX of
 // their penalty energies about the volume and area of mesh.nodes; docs/volume-conservation.md).
 // See docs/membrane-bending.md for the derivations, the lumping rule and the two deviations from the paper
@@ -27,6 +28,7 @@
 #include "immerse/core/Vec3.hpp"
 #include "immerse/membrane/CurvatureFit.hpp"
 #include "immerse/membrane/MaterialLaw.hpp"
+#include "immerse/membrane/MeanCurvatureBending.hpp"
 #include "immerse/membrane/Mesh.hpp"
 #include "immerse/membrane/VolumeAreaConstraint.hpp"
 
@@ -34,12 +36,12 @@ namespace immerse {
 
 enum class ForceMethod { Contour, Energy };
 
-/// Reference mean curvature kappa_m^R of eq. (25): zero, or per node that of the reference (rest) shape.
-enum class ReferenceCurvature { Zero, RestShape };
-
-struct Bending {
-  double kappa_B = 0;  ///< bending modulus, J (N m); 0 switches bending off
-  ReferenceCurvature reference = ReferenceCurvature::Zero;
+/// The parts of a membrane's discrete energy (J).
+struct MembraneEnergy {
+  double elastic = 0;     ///< in-plane: sum_e sum_gp W(A1, A2) Jbar w
+  double bending = 0;     ///< MeanCurvatureBending's E_B (0 without bending)
+  double constraint = 0;  ///< VolumeAreaConstraint's penalty energies
+  double total() const { return elastic + bending + constraint; }
 };
 
 /// Per-node strain and tension for output: invariants (19)-(20), principal stretches and principal tensions.
@@ -61,8 +63,11 @@ class ElasticMembrane {
   /// constraint forces included. Thread-safe for concurrent calls; OpenMP inside; independent of the thread count.
   /// SimulationError naming the element if one inverts or degenerates (Jacobian <= 0 or not finite).
   void compute_force(std::span<const Vec3> X, std::vector<Vec3>& F) const;
-  /// Discrete in-plane elastic energy E (J) = sum_e sum_gp W(A1, A2) Jbar w (without the constraints' energy).
+  /// Discrete in-plane elastic energy E (J) = sum_e sum_gp W(A1, A2) Jbar w (without bending and constraints).
   double compute_energy(std::span<const Vec3> X) const;
+  /// In-plane, bending (E_B of MeanCurvatureBending, also reported for the contour method, whose forces are not
+  /// its gradient) and constraint energies at X.
+  MembraneEnergy energy_parts(std::span<const Vec3> X) const;
 
   /// Strain and tension at each node: invariants A1, A2 at the element nodes averaged over the elements sharing
   /// the node, principal stretches from them and principal tensions from (18) in principal axes.
@@ -72,7 +77,8 @@ class ElasticMembrane {
   std::vector<double> node_area(std::span<const Vec3> X) const;
   /// Unit normal at each node: normalized average of the normals of the elements sharing it (used by eq. 42).
   std::vector<Vec3> node_normal(std::span<const Vec3> X) const;
-  /// kappa_m^R of eq. (25) per node (1/m); zero unless kappa_B > 0 with ReferenceCurvature::RestShape.
+  /// kappa_m^R of eq. (25) per node (1/m) for the contour method; zero unless kappa_B > 0 with
+  /// ReferenceCurvature::RestShape and ForceMethod::Contour.
   const std::vector<double>& reference_curvature() const { return kappa_ref_; }
 
   std::size_t num_nodes() const { return reference_.size(); }
@@ -111,6 +117,7 @@ class ElasticMembrane {
   bool threaded_ = false;  ///< large enough for OpenMP threads (kMinElementsForThreads)
   std::optional<CurvatureFit> fit_;  ///< nodal normal and curvature for the bending moments (kappa_B > 0)
   std::optional<VolumeAreaConstraint> constraint_;
+  std::optional<MeanCurvatureBending> bending_energy_;  ///< kappa_B > 0
 };
 
 }  // namespace immerse

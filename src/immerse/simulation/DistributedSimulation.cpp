@@ -58,7 +58,7 @@ FluidEnergy DistributedSimulation::fluid_energy() const {
   return fluid_energy_total(grid_, fluid_.params(), slabs.communicator().sum(mine));
 }
 
-std::vector<MembraneEnergyParts> DistributedSimulation::membrane_energies() const {
+std::vector<MembraneEnergy> DistributedSimulation::membrane_energies() const {
   // Each membrane's energies from its owner, zeros elsewhere: the sum over the processes is exact.
   const std::size_t M = num_membranes();
   std::vector<double> mine(3 * M, 0.0);
@@ -66,7 +66,7 @@ std::vector<MembraneEnergyParts> DistributedSimulation::membrane_energies() cons
   for (const OwnedMembrane& o : op_->ownership().owned()) {
     const auto m = static_cast<std::size_t>(o.id);
     try {
-      const MembraneEnergyParts e = membrane_energy(*membranes_.membranes[m], o.positions);
+      const MembraneEnergy e = membrane_energy(*membranes_.membranes[m], o.positions);
       mine[3 * m] = e.elastic;
       mine[3 * m + 1] = e.bending;
       mine[3 * m + 2] = e.constraint;
@@ -77,13 +77,13 @@ std::vector<MembraneEnergyParts> DistributedSimulation::membrane_energies() cons
   const Communicator& comm = fluid_.decomposition().communicator();
   if (const std::string first = first_error(comm, error); !first.empty()) throw SimulationError(first);
   const std::vector<double> all = comm.sum(mine);
-  std::vector<MembraneEnergyParts> parts(M);
+  std::vector<MembraneEnergy> parts(M);
   for (std::size_t m = 0; m < M; ++m) parts[m] = {all[3 * m], all[3 * m + 1], all[3 * m + 2]};
   return parts;
 }
 
 void DistributedSimulation::start_budget() {
-  const std::vector<MembraneEnergyParts> parts = membrane_energies();
+  const std::vector<MembraneEnergy> parts = membrane_energies();
   const FluidEnergy fluid = fluid_energy();
   budget_.start(total_energy(fluid.kinetic, parts), fluid);
 }

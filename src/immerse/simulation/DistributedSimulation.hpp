@@ -93,7 +93,7 @@ class DistributedSimulation {
   FluidEnergy fluid_energy() const;
   /// The energies of every membrane at its committed positions, from the processes owning them, on every process.
   /// SimulationError on every process if a membrane's cannot be evaluated. Collective.
-  std::vector<MembraneEnergyParts> membrane_energies() const;
+  std::vector<MembraneEnergy> membrane_energies() const;
 
   /// Continues from a checkpoint of the same configuration written by any number of processes (or by Simulation):
   /// every process passes the whole checkpoint; the fluid is cut into this run's slabs and the membranes are owned

@@ -7,14 +7,9 @@
 namespace immerse {
 
 // The one place that knows how ElasticMembrane splits its energy.
-MembraneEnergyParts membrane_energy(const ElasticMembrane& m, std::span<const Vec3> X) {
-  MembraneEnergyParts e;
-  e.elastic = m.compute_energy(X);
-  if (m.constraint()) e.constraint = m.constraint()->energy(X);
-  return e;
-}
+MembraneEnergy membrane_energy(const ElasticMembrane& m, std::span<const Vec3> X) { return m.energy_parts(X); }
 
-double total_energy(double kinetic, std::span<const MembraneEnergyParts> membranes) {
+double total_energy(double kinetic, std::span<const MembraneEnergy> membranes) {
   double total = kinetic;
   for (const auto& m : membranes) total += m.total();
   return total;

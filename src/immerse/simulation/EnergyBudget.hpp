@@ -26,19 +26,11 @@
 
 namespace immerse {
 
-/// The energies of one membrane (J).
-struct MembraneEnergyParts {
-  double elastic = 0;     ///< in-plane strain energy
-  double bending = 0;     ///< bending energy (0 without one)
-  double constraint = 0;  ///< penalty energies of the volume and area constraints
-  double total() const { return elastic + bending + constraint; }
-};
-
 /// The energies of membrane m at positions X (SimulationError if an element is inverted).
-MembraneEnergyParts membrane_energy(const ElasticMembrane& m, std::span<const Vec3> X);
+MembraneEnergy membrane_energy(const ElasticMembrane& m, std::span<const Vec3> X);
 
 /// E_total: the kinetic energy of the fluid plus every membrane's energies, added in membrane order.
-double total_energy(double kinetic, std::span<const MembraneEnergyParts> membranes);
+double total_energy(double kinetic, std::span<const MembraneEnergy> membranes);
 
 class EnergyBudget {
  public:

@@ -49,11 +49,13 @@ ConfigSchema membrane_schema() {
   m.add_double("C30", 1.7e-7, Range::positive(), "Yeoh C30 of eq. (23) (N/m)");
   m.add_double("C11", 5e-6, Range::positive(), "Skalak C11 of eq. (24) (N/m)");
   m.add_double("C21", 5e-4, Range::positive(), "Skalak C21 of eq. (24) (N/m)");
-  m.add_double("kappa_B", 0.0, Range::non_negative(), "bending modulus of eq. (25) (J); 0 switches bending off");
+  m.add_double("kappa_B", 0.0, Range::non_negative(), "bending modulus kappa_B of eq. (25) and of the bending energy (J); 0 switches bending off");
   m.add_string("bending_reference", "zero", {"zero", "rest"},
                "reference mean curvature of eq. (25): zero (flat rest state, §4.2.3) or that of the reference shape");
-  m.add_string("force", "contour", {"contour", "energy"},
-               "nodal forces by the contour integral of eq. (42), or energy-consistent -dE/dX");
+  m.add_string("force", "energy", {"energy", "contour"},
+               "nodal forces: -dE/dX of the in-plane energy and the discrete mean-curvature bending energy (energy "
+               "stable: a membrane at rest cannot gain energy), or the paper's contour integral of eq. (42) with the "
+               "bending moments of eq. (25)");
   m.add_double("volume_modulus", 0.0, Range::non_negative(),
                "k_V of the global volume constraint E_V = k_V (V - V0)^2 / (2 V0), V0 the initial volume (Pa: k_V dV/V0 "
                "is the pressure jump it adds); 0 switches it off (docs/volume-conservation.md)");

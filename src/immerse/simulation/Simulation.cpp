@@ -62,12 +62,12 @@ FluidEnergy Simulation::fluid_energy() const {
   return immerse::fluid_energy(grid_, fluid_.params(), op_->fluid_state().u, chi.size() > 0 ? &chi : nullptr);
 }
 
-MembraneEnergyParts Simulation::membrane_energy(std::size_t m) const {
+MembraneEnergy Simulation::membrane_energy(std::size_t m) const {
   return immerse::membrane_energy(*membranes_[m], op_->membrane_positions(m));
 }
 
 void Simulation::start_budget() {
-  std::vector<MembraneEnergyParts> parts;
+  std::vector<MembraneEnergy> parts;
   for (std::size_t m = 0; m < num_membranes(); ++m) parts.push_back(membrane_energy(m));
   const FluidEnergy fluid = fluid_energy();
   budget_.start(total_energy(fluid.kinetic, parts), fluid);

@@ -57,7 +57,7 @@ class Simulation {
   /// The fluid measures of the committed state, with the viscosity of the last step (FluidEnergy.hpp).
   FluidEnergy fluid_energy() const;
   /// The energies of membrane m at its committed positions.
-  MembraneEnergyParts membrane_energy(std::size_t m) const;
+  MembraneEnergy membrane_energy(std::size_t m) const;
 
   /// External nodal forces on membrane m (see ImmersedBoundaryOperator::set_applied_forces).
   void set_applied_forces(std::size_t m, const std::vector<Vec3>& F) { op_->set_applied_forces(m, F); }
