@@ -24,22 +24,14 @@ namespace {
 
 using Row = std::map<std::string, double>;
 
+/// diagnostics.csv as rows keyed by column name (read_csv of test_run_support.hpp).
 std::vector<Row> read_rows(const fs::path& csv) {
-  std::ifstream f(csv);
-  std::string line;
-  std::vector<std::string> names;
+  const auto cells = read_csv(csv);
   std::vector<Row> rows;
-  while (std::getline(f, line)) {
-    std::vector<std::string> cells;
-    std::stringstream ss(line);
-    for (std::string c; std::getline(ss, c, ',');) cells.push_back(c);
-    if (names.empty()) {
-      names = cells;
-      continue;
-    }
-    Row r;
-    for (std::size_t c = 0; c < cells.size() && c < names.size(); ++c) r[names[c]] = std::stod(cells[c]);
-    rows.push_back(r);
+  for (std::size_t r = 1; r < cells.size(); ++r) {
+    Row row;
+    for (std::size_t c = 0; c < cells[r].size() && c < cells[0].size(); ++c) row[cells[0][c]] = std::stod(cells[r][c]);
+    rows.push_back(row);
   }
   return rows;
 }
