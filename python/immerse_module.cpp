@@ -252,6 +252,20 @@ line's --set: a dict {"scenario.G": 0.1, ...} or a list of "KEY=VALUE" strings. 
           },
           py::arg("membrane") = 0, "Node positions of a membrane (m), an (N, 3) numpy array.")
       .def(
+          "elements",
+          [](const PySimulation& s, std::size_t i) {
+            s.check_membrane(i);
+            const auto& el = s.sim().mesh(i).elements;
+            py::array_t<int> a({static_cast<py::ssize_t>(el.size()), py::ssize_t{6}});
+            auto r = a.mutable_unchecked<2>();
+            for (std::size_t e = 0; e < el.size(); ++e)
+              for (int k = 0; k < 6; ++k) r(static_cast<py::ssize_t>(e), k) = el[e][k];
+            return a;
+          },
+          py::arg("membrane") = 0,
+          "Node indices of a membrane's six-node elements, an (E, 6) numpy array: vertices v0 v1 v2 "
+          "(counter-clockwise seen from outside), then the mid-side nodes of edges 0-1, 1-2, 2-0.")
+      .def(
           "velocities",
           [](const PySimulation& s, std::size_t i) {
             s.check_membrane(i);

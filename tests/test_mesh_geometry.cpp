@@ -112,6 +112,29 @@ TEST(Geometry, NodeAreaWeightsArePositiveAndSumToTheArea) {
   EXPECT_NEAR(wf[flat.elements[0][3]], 6 * face / 4 / 3, 1e-15);  // mid-side node: three per face, two faces
 }
 
+TEST(Geometry, LeastAreaRatioIsTheLocalDilationAndNamesItsElement) {
+  const Mesh m = icosahedral_sphere(2);
+  const auto ref = element_areas(m, m.nodes);
+  EXPECT_NEAR(std::accumulate(ref.begin(), ref.end(), 0.0) / area(m, m.nodes), 1.0, 1e-14);
+  // A uniform stretch by lambda multiplies every element's area by lambda^2.
+  std::vector<Vec3> X = m.nodes;
+  for (auto& x : X) x *= 1.3;
+  EXPECT_NEAR(least_area_ratio(m, X, ref).ratio, 1.69, 1e-13);
+  // Pulling one element's mid-side nodes onto the centroid of its vertices shrinks it below its neighbours:
+  // the sub-triangles (v0 m01 m20), (m01 v1 m12), (m20 m12 v2) keep a third of the flat triangle and (m01 m12 m20)
+  // vanishes, while the elements sharing those mid-side nodes grow.
+  const std::size_t e = 17;
+  const auto& el = m.elements[e];
+  const Vec3 c = (m.nodes[el[0]] + m.nodes[el[1]] + m.nodes[el[2]]) / 3.0;
+  X = m.nodes;
+  for (int k = 3; k < 6; ++k) X[el[k]] = c;
+  const LeastAreaRatio least = least_area_ratio(m, X, ref);
+  EXPECT_EQ(least.element, e);
+  const double flat = 0.5 * norm(cross(m.nodes[el[1]] - m.nodes[el[0]], m.nodes[el[2]] - m.nodes[el[0]]));
+  EXPECT_LT(least.ratio, flat / ref[e]);
+  EXPECT_GT(least.ratio, 0.0);
+}
+
 TEST(Geometry, ResultsDoNotDependOnTheThreadCount) {
   const Mesh m = icosahedral_sphere(4);
   const auto X = map_sphere(Shape{Ellipsoid{1.0, 0.8, 0.6}, {}}, m.nodes);

@@ -96,9 +96,10 @@ TEST_F(RunOutputTest, FilesRecordTheirProvenanceAndUnits) {
   }
   EXPECT_EQ(units[2][1], "s");    // time
   EXPECT_EQ(units[9][1], "m^3");  // volume
-  EXPECT_EQ(units[19][1], "J");   // E_kinetic
-  EXPECT_EQ(units[20][1], "W");   // dissipation
-  EXPECT_EQ(units[27][1], "J");   // budget_residual
+  EXPECT_EQ(units[19][1], "1");   // min_area_ratio
+  EXPECT_EQ(units[20][1], "J");   // E_kinetic
+  EXPECT_EQ(units[21][1], "W");   // dissipation
+  EXPECT_EQ(units[28][1], "J");   // budget_residual
 }
 
 TEST_F(RunOutputTest, DiagnosticsHaveTheDocumentedHeaderAndOneRowPerStep) {
@@ -111,7 +112,7 @@ TEST_F(RunOutputTest, DiagnosticsHaveTheDocumentedHeaderAndOneRowPerStep) {
   for (const auto& c : rows[0]) header += (header.empty() ? "" : ",") + c;
   EXPECT_EQ(header,
             "step,time,dt,newton_its,gmres_its,fluid_solves,residual,wall_s,volume,area,cx,cy,cz,a1,a2,a3,D_xz,theta,"
-            "E_kinetic,dissipation,P_walls,P_body,E_elastic,E_bending,E_constraint,E_total,budget_residual");
+            "min_area_ratio,E_kinetic,dissipation,P_walls,P_body,E_elastic,E_bending,E_constraint,E_total,budget_residual");
   for (int s = 1; s <= kSteps; ++s) {
     const auto& r = rows[s + 1];
     ASSERT_EQ(r.size(), rows[0].size());
@@ -183,25 +184,27 @@ TEST(RunOutput, WithoutFieldsNoParaViewFilesAndAPrefixPerMembrane) {
   ASSERT_EQ(run_command(o, log, err), 0) << err.str();
   const auto rows = read_csv(o.out / "diagnostics.csv");
   ASSERT_EQ(rows.size(), 4u);
-  ASSERT_EQ(rows[0].size(), 8u + 2 * 10 + 4 + 2 * 3 + 2);
+  ASSERT_EQ(rows[0].size(), 8u + 2 * 11 + 4 + 2 * 3 + 2);
   EXPECT_EQ(rows[0][8], "m0_volume");
-  EXPECT_EQ(rows[0][18], "m1_volume");
-  EXPECT_EQ(rows[0][27], "m1_theta");
+  EXPECT_EQ(rows[0][18], "m0_min_area_ratio");
+  EXPECT_EQ(rows[0][19], "m1_volume");
+  EXPECT_EQ(rows[0][28], "m1_theta");
   // Then the energy budget: the fluid's columns, each membrane's energies, the totals.
-  EXPECT_EQ(rows[0][28], "E_kinetic");
-  EXPECT_EQ(rows[0][32], "m0_E_elastic");
-  EXPECT_EQ(rows[0][37], "m1_E_constraint");
-  EXPECT_EQ(rows[0][38], "E_total");
-  EXPECT_EQ(rows[0][39], "budget_residual");
+  EXPECT_EQ(rows[0][30], "E_kinetic");
+  EXPECT_EQ(rows[0][34], "m0_E_elastic");
+  EXPECT_EQ(rows[0][39], "m1_E_constraint");
+  EXPECT_EQ(rows[0][40], "E_total");
+  EXPECT_EQ(rows[0][41], "budget_residual");
   // E_total adds up the kinetic energy and the energies of both (stretched) capsules.
-  const double E_total = std::stod(rows[3][38]);
-  EXPECT_NEAR(E_total, std::stod(rows[3][28]) + std::stod(rows[3][32]) + std::stod(rows[3][35]), 1e-15 * E_total);
-  EXPECT_GT(std::stod(rows[3][32]), 0);
-  EXPECT_GT(std::stod(rows[3][35]), 0);
-  // Mirror images about x = 1 in a symmetric box: same volumes, centroids at 0.5 and 1.5.
-  EXPECT_NEAR(std::stod(rows[3][8]), std::stod(rows[3][18]), 1e-12);
+  const double E_total = std::stod(rows[3][40]);
+  EXPECT_NEAR(E_total, std::stod(rows[3][30]) + std::stod(rows[3][34]) + std::stod(rows[3][37]), 1e-15 * E_total);
+  EXPECT_GT(std::stod(rows[3][34]), 0);
+  EXPECT_GT(std::stod(rows[3][37]), 0);
+  // Mirror images about x = 1 in a symmetric box: same volumes, least area ratios and centroids at 0.5 and 1.5.
+  EXPECT_NEAR(std::stod(rows[3][8]), std::stod(rows[3][19]), 1e-12);
+  EXPECT_NEAR(std::stod(rows[3][18]), std::stod(rows[3][29]), 1e-9);
   EXPECT_NEAR(std::stod(rows[3][10]), 0.5, 1e-3);
-  EXPECT_NEAR(std::stod(rows[3][20]), 1.5, 1e-3);
+  EXPECT_NEAR(std::stod(rows[3][21]), 1.5, 1e-3);
   EXPECT_FALSE(fs::exists(o.out / "membranes.xdmf"));
   EXPECT_FALSE(fs::exists(o.out / "fluid.xdmf"));
   EXPECT_FALSE(fs::exists(o.out / "fields_000000.h5"));

@@ -31,7 +31,9 @@ const std::vector<Column> kMembraneColumns{
     {"a2", "m", "semi-axis of the equivalent ellipsoid closest to y"},
     {"a3", "m", "semi-axis of the equivalent ellipsoid closest to z"},
     {"D_xz", "1", "Taylor deformation (L - B) / (L + B) of the section by the x-z plane through the centroid"},
-    {"theta", "rad", "inclination of the longest principal axis to x in the x-z plane"}};
+    {"theta", "rad", "inclination of the longest principal axis to x in the x-z plane"},
+    {"min_area_ratio", "1",
+     "least ratio of an element's area to its area in the stress-free reference (the local area dilation J)"}};
 // The energy budget (docs/energy-budget.md): the fluid's measures, each membrane's energies, then the run's totals.
 const std::vector<Column> kFluidEnergyColumns{
     {"E_kinetic", "J", "kinetic energy of the fluid: rho/2 sum of u^2 h^3 over the velocity unknowns"},
@@ -125,7 +127,8 @@ std::vector<double> Diagnostics::row(const Simulation& sim, const StepRecord& r)
     const ShearPlaneProfile p = shear_plane_profile(sim.mesh(m), X, g.centroid);
     const auto a = semi_axes_along_xyz(g);
     row.insert(row.end(), {g.volume, g.area, g.centroid.x, g.centroid.y, g.centroid.z, a[0], a[1], a[2], p.D_xz,
-                           inclination(g)});
+                           inclination(g),
+                           least_area_ratio(sim.mesh(m), X, sim.membrane(m).reference_element_areas()).ratio});
     scenario_.add_membrane_values(X, row);
   }
   scenario_.add_run_values(sim, row);

@@ -557,7 +557,10 @@ class DistributedLoop {
         const ShearPlaneProfile p = shear_plane_profile(sim_.membranes().meshes[m], X[m], g.centroid);
         const auto a = semi_axes_along_xyz(g);
         row.insert(row.end(), {g.volume, g.area, g.centroid.x, g.centroid.y, g.centroid.z, a[0], a[1], a[2], p.D_xz,
-                               inclination(g)});
+                               inclination(g),
+                               least_area_ratio(sim_.membranes().meshes[m], X[m],
+                                                sim_.membranes().membranes[m]->reference_element_areas())
+                                   .ratio});
         scenario_.add_membrane_values(X[m], row);
       }
       if (channel_) row.push_back(mean_velocity);

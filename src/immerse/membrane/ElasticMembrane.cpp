@@ -9,6 +9,7 @@
 #include "immerse/core/Error.hpp"
 #include "immerse/core/Mat3.hpp"
 #include "immerse/membrane/BalancedRange.hpp"
+#include "immerse/membrane/Geometry.hpp"
 #include "immerse/membrane/MembraneKinematics_K.hpp"
 #include "immerse/membrane/QuadraticTriangle_K.hpp"
 #include "immerse/core/Parallel.hpp"
@@ -194,6 +195,7 @@ ElasticMembrane::ElasticMembrane(const Mesh& mesh, std::vector<Vec3> reference, 
   for (std::size_t e = 0; e < E; ++e)
     for (int k = 0; k < 6; ++k) inc_[fill[elements_[e][k]]++] = static_cast<int>(6 * e + k);
 
+  ref_element_area_ = element_areas(mesh, reference_);
   // Reference metric at the element nodes (contour method, node_strain) and quadrature points (energy method).
   ref_node_.resize(4 * 6 * E);
   ref_quad_.resize(4 * tri6::kQuadPoints * E);

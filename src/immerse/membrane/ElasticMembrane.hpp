@@ -86,6 +86,9 @@ class ElasticMembrane {
   /// The elements' node indices (Mesh::elements).
   const std::vector<std::array<int, 6>>& elements() const { return elements_; }
   ForceMethod method() const { return method_; }
+  /// Curved area of each element in the stress-free reference (element_areas of Geometry), the denominators of
+  /// the local area ratio.
+  std::span<const double> reference_element_areas() const { return ref_element_area_; }
   /// The global volume and area constraints, when a modulus is > 0.
   const std::optional<VolumeAreaConstraint>& constraint() const { return constraint_; }
   const MaterialLaw& law() const { return law_; }
@@ -114,6 +117,7 @@ class ElasticMembrane {
   std::vector<double> ref_node_;  ///< per element node: Gbar^{xx}, Gbar^{xe}, Gbar^{ee}, Jbar (4 doubles)
   std::vector<double> ref_quad_;  ///< per quadrature point: Gbar^{xx}, Gbar^{xe}, Gbar^{ee}, Jbar w
   std::vector<double> kappa_ref_;
+  std::vector<double> ref_element_area_;
   bool threaded_ = false;  ///< large enough for OpenMP threads (kMinElementsForThreads)
   std::optional<CurvatureFit> fit_;  ///< nodal normal and curvature for the bending moments (kappa_B > 0)
   std::optional<VolumeAreaConstraint> constraint_;

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "immerse/membrane/MeshElement.hpp"
 #include "immerse/core/Parallel.hpp"
@@ -9,7 +10,7 @@
 namespace immerse {
 namespace {
 
-MeshElement::Nodes element_nodes(const Mesh& mesh, const std::vector<Vec3>& X, std::size_t e, const Vec3& origin) {
+MeshElement::Nodes element_nodes(const Mesh& mesh, std::span<const Vec3> X, std::size_t e, const Vec3& origin) {
   MeshElement::Nodes x;
   for (int i = 0; i < 6; ++i) x[i] = X[mesh.elements[e][i]] - origin;
   return x;
@@ -115,7 +116,7 @@ SymmetricEigen symmetric_eigen(Mat3 a) {
 
 }  // namespace
 
-double area(const Mesh& mesh, const std::vector<Vec3>& X) {
+std::vector<double> element_areas(const Mesh& mesh, std::span<const Vec3> X) {
   std::vector<double> part(mesh.num_elements(), 0.0);
   const auto ne = static_cast<std::ptrdiff_t>(mesh.num_elements());
 #pragma omp parallel for if (ne >= kMinElementsForThreads)
@@ -123,9 +124,21 @@ double area(const Mesh& mesh, const std::vector<Vec3>& X) {
     const auto a = sub_triangle_areas(element_nodes(mesh, X, static_cast<std::size_t>(e), {}));
     part[e] = a[0] + a[1] + a[2] + a[3];
   }
+  return part;
+}
+
+double area(const Mesh& mesh, const std::vector<Vec3>& X) {
   double s = 0;
-  for (double a : part) s += a;
+  for (double a : element_areas(mesh, X)) s += a;
   return s;
+}
+
+LeastAreaRatio least_area_ratio(const Mesh& mesh, std::span<const Vec3> X, std::span<const double> reference_areas) {
+  const auto a = element_areas(mesh, X);
+  LeastAreaRatio least{std::numeric_limits<double>::infinity(), 0};
+  for (std::size_t e = 0; e < a.size(); ++e)
+    if (const double r = a[e] / reference_areas[e]; r < least.ratio) least = {r, e};
+  return least;
 }
 
 double volume(const Mesh& mesh, const std::vector<Vec3>& X) {

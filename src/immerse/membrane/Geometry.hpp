@@ -24,6 +24,8 @@
 // Verified by: the study sphere_geometry (curved unit sphere area and volume at order ≥ 3, ellipsoid volume and
 // axes, red cell volume and area) and the tests Geometry.*.
 #include <array>
+#include <cstddef>
+#include <span>
 #include <vector>
 
 #include "immerse/core/Mat3.hpp"
@@ -40,6 +42,15 @@ struct MembraneGeometry {
 
 /// Surface area of the curved surface with node positions X (same indexing as mesh.nodes).
 double area(const Mesh& mesh, const std::vector<Vec3>& X);
+/// Curved area of each element (the sum of its four sub-triangles' areas; they add up to area(mesh, X)).
+std::vector<double> element_areas(const Mesh& mesh, std::span<const Vec3> X);
+/// Least ratio of an element's area at X to its area in `reference_areas` (element_areas of the stress-free
+/// reference), with the element that has it: the local area dilation J of the membrane law, at its lowest.
+struct LeastAreaRatio {
+  double ratio = 1;
+  std::size_t element = 0;
+};
+LeastAreaRatio least_area_ratio(const Mesh& mesh, std::span<const Vec3> X, std::span<const double> reference_areas);
 /// Enclosed volume (positive for outward-oriented elements).
 double volume(const Mesh& mesh, const std::vector<Vec3>& X);
 /// Inertia tensor I = ∫_V (|r|² 1 - r rᵀ) dV of the enclosed volume with unit density, r from the
