@@ -1,5 +1,5 @@
-// Strain-energy laws (22)-(24): derivatives against central differences, isotropic tension against the
-// closed forms, small-strain moduli, bad input.
+// Strain-energy laws (22)-(24), alone and with the area dilation energy W_D = (K_D/2)(ln J)^2: derivatives
+// against central differences, isotropic tension against the closed forms, small-strain moduli, bad input.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -10,10 +10,23 @@ using namespace immerse;
 
 namespace {
 
-const MaterialLaw kLaws[] = {NeoHookean{2.5}, Yeoh{0.7, 0.04}, Skalak{0.3, 4.0}};
+const MaterialLaw kLaws[] = {NeoHookean{2.5},
+                             Yeoh{0.7, 0.04},
+                             Skalak{0.3, 4.0},
+                             WithAreaDilation<NeoHookean>{NeoHookean{2.5}, 40.0},
+                             WithAreaDilation<Yeoh>{Yeoh{0.7, 0.04}, 40.0},
+                             WithAreaDilation<Skalak>{Skalak{0.3, 4.0}, 40.0}};
 
-/// Closed forms derived in the law headers for equal principal stretches lambda.
+/// Closed forms derived in the law headers for equal principal stretches lambda; the area dilation energy adds
+/// tau_D = K_D ln J / J with J = lambda^2.
 double closed_form_tension(const MaterialLaw& law, double l) {
+  const auto dilated = [&](const auto* w) {
+    const double J = l * l;
+    return closed_form_tension(w->law, l) + w->K_D * std::log(J) / J;
+  };
+  if (const auto* w = std::get_if<WithAreaDilation<NeoHookean>>(&law)) return dilated(w);
+  if (const auto* w = std::get_if<WithAreaDilation<Yeoh>>(&law)) return dilated(w);
+  if (const auto* w = std::get_if<WithAreaDilation<Skalak>>(&law)) return dilated(w);
   if (const auto* w = std::get_if<NeoHookean>(&law)) return w->Es / 3 * (1 - std::pow(l, -6));
   if (const auto* w = std::get_if<Yeoh>(&law)) {
     const double I = 2 * l * l + std::pow(l, -4) - 3;
@@ -65,6 +78,26 @@ TEST(MembraneMaterial, SmallStrainAreaModuli) {
   const double mu0 = 0.8;
   EXPECT_NEAR(K(Yeoh{mu0 / 2, mu0 / 30}), 3 * mu0, 1e-8);
   EXPECT_NEAR(K(Skalak{0.2, 5.0}), 0.1 + 5.0, 1e-8);
+  // The area dilation energy adds K_D.
+  EXPECT_NEAR(K(with_area_dilation(Skalak{0.2, 5.0}, 70.0)), 0.1 + 5.0 + 70.0, 1e-7);
+  EXPECT_NEAR(K(with_area_dilation(NeoHookean{3.0}, 70.0)), 3.0 + 70.0, 1e-7);
+  EXPECT_NEAR(K(without_area_dilation(with_area_dilation(NeoHookean{3.0}, 70.0))), 3.0, 1e-8);
+}
+
+// Skalak's compressive tension peaks at J = 1/sqrt(3) and softens below (a compressed patch past it collapses at
+// a bounded energy); with the area dilation energy the tension keeps falling as J -> 0.
+TEST(MembraneMaterial, AreaDilationEnergyHasNoCompressiveSoftening) {
+  const Skalak skalak{0.2, 2.0};
+  const MaterialLaw plain = skalak, dilated = with_area_dilation(skalak, 20.0);
+  const double peak = std::pow(1.0 / 3, 0.25);  // lambda at J = 1/sqrt(3)
+  EXPECT_GT(isotropic_tension(plain, 0.5 * peak), isotropic_tension(plain, peak));  // softened
+  double last = 0;
+  for (double J = 0.99; J > 1e-3; J *= 0.9) {
+    const double tau = isotropic_tension(dilated, std::sqrt(J));
+    EXPECT_LT(tau, last) << "J = " << J;
+    last = tau;
+  }
+  EXPECT_LT(last, -1e5);  // K_D ln J / J = -1.2e5 at J = 1.1e-3
 }
 
 // The neo-Hookean Laplace pressure of an inflated sphere, dp a / Gs = 2 tau / (lambda Gs), peaks at
@@ -96,4 +129,5 @@ TEST(MembraneMaterial, NonPositiveModulusIsAnInputError) {
   } catch (const InputError& e) {
     EXPECT_STREQ(e.what(), "membrane.law.C21 = -3: must be >= 0");
   }
+  EXPECT_THROW((WithAreaDilation<Skalak>{Skalak{1.0, 1.0}, -1.0}), InputError);
 }

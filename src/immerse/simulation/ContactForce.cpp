@@ -13,7 +13,8 @@ namespace immerse {
 double small_strain_area_modulus(const MaterialLaw& law) {
   // tau ~ 2 K_s (lambda - 1) for small isotropic stretches; the central difference is within 1e-8 of it.
   const double dl = 1e-5;
-  return (isotropic_tension(law, 1 + dl) - isotropic_tension(law, 1 - dl)) / (4 * dl);
+  const MaterialLaw in_plane = without_area_dilation(law);
+  return (isotropic_tension(in_plane, 1 + dl) - isotropic_tension(in_plane, 1 - dl)) / (4 * dl);
 }
 
 ContactForce::ContactForce(const Grid& grid, const ContactSettings& settings, const std::vector<std::size_t>& offsets,

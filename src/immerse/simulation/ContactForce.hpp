@@ -15,8 +15,9 @@
 //        the two membranes' forces)
 //   eps  contact.strength (dimensionless; default 1)
 //   K    the small-strain area modulus K_s (N/m) of the membrane, (K_a + K_b) / 2 for a pair: neo-Hookean E_s,
-//        Yeoh 6 C10, Skalak C11/2 + C21 (small_strain_area_modulus); the largest force of one pair, eps K d, is
-//        that of a membrane strip of width d stretched to twice its area
+//        Yeoh 6 C10, Skalak C11/2 + C21 (small_strain_area_modulus, of the in-plane law without the area dilation
+//        energy, whose large K_D would stiffen every contact); the largest force of one pair, eps K d, is that of a
+//        membrane strip of width d stretched to twice its area
 // F_i = -dE/dX_i exactly, and the forces of a pair are equal and opposite to the last bit (total force zero).
 // The law is the soft repulsion of dissipative particle dynamics, F = a (1 - r/d) (Groot & Warren, J. Chem. Phys.
 // 107, 4423 (1997)), squared for a continuous derivative at r = d.
@@ -47,7 +48,8 @@ struct ContactSettings {
   bool walls = true;    ///< node-wall repulsion on the wall axes
 };
 
-/// K_s = (1/2) d tau / d lambda at lambda = 1 of the isotropic tension (MaterialLaw.hpp), N/m.
+/// K_s = (1/2) d tau / d lambda at lambda = 1 of the isotropic tension (MaterialLaw.hpp) of the law without its
+/// area dilation energy, N/m.
 double small_strain_area_modulus(const MaterialLaw& law);
 
 class ContactForce {

@@ -53,11 +53,15 @@ Shape shape_of(const io::Config& m, bool reference) {
   return s;
 }
 
-MaterialLaw law_of(const io::Config& m) {
+MaterialLaw in_plane_law_of(const io::Config& m) {
   const std::string law = m.get<std::string>("law");
   if (law == "neo_hookean") return NeoHookean(m.get<double>("Es"));
   if (law == "yeoh") return Yeoh(m.get<double>("C10"), m.get<double>("C30"));
   return Skalak(m.get<double>("C11"), m.get<double>("C21"));
+}
+
+MaterialLaw law_of(const io::Config& m) {
+  return with_area_dilation(in_plane_law_of(m), m.get<double>("dilation_modulus"));
 }
 
 std::string membrane_name(std::size_t m) { return "membrane[" + std::to_string(m) + "]"; }

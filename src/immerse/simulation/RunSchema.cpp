@@ -49,6 +49,10 @@ ConfigSchema membrane_schema() {
   m.add_double("C30", 1.7e-7, Range::positive(), "Yeoh C30 of eq. (23) (N/m)");
   m.add_double("C11", 5e-6, Range::positive(), "Skalak C11 of eq. (24) (N/m)");
   m.add_double("C21", 5e-4, Range::positive(), "Skalak C21 of eq. (24) (N/m)");
+  m.add_double("dilation_modulus", 0.0, Range::non_negative(),
+               "K_D of the local area dilation energy W_D = (K_D/2) (ln J)^2 added to the law at every quadrature "
+               "point, J the local area ratio (N/m: adds K_D to the small-strain area modulus; its compressive tension "
+               "K_D ln J / J grows without bound as J -> 0; src/immerse/membrane/AreaDilation.hpp); 0 switches it off");
   m.add_double("kappa_B", 0.0, Range::non_negative(), "bending modulus kappa_B of eq. (25) and of the bending energy (J); 0 switches bending off");
   m.add_string("bending_reference", "zero", {"zero", "rest"},
                "reference mean curvature of eq. (25): zero (flat rest state, §4.2.3) or that of the reference shape");
@@ -143,7 +147,7 @@ ConfigSchema run_schema() {
   s.add_double("contact.strength", 1.0, Range::positive(),
                "contact force scale eps (dimensionless): the largest force of one pair of nodes is eps K_s d, with "
                "K_s the small-strain area modulus of the membranes (N/m; neo-Hookean E_s, Yeoh 6 C10, Skalak "
-               "C11/2 + C21)");
+               "C11/2 + C21; without dilation_modulus)");
   s.add_bool("contact.walls", true, "repel the nodes from the no-slip walls as well (contact.range > 0)");
 
   s.add_string("time.scheme", "jfnk", integrator_names(),
