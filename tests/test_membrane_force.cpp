@@ -70,6 +70,23 @@ TEST(MembraneForce, InvertedElementIsASimulationErrorNamingIt) {
   }
 }
 
+// A mid-side node slid along its edge past the quarter point: the Jacobian vanishes at the vertex it approaches
+// while every quadrature point still sees a positive one. Both methods refuse the state (eq. (42) evaluates the
+// element nodes anyway; the energy method checks them), so a time step cannot accept a corner-folded element.
+TEST(MembraneForce, ElementFoldedAtAVertexIsRefusedByBothMethods) {
+  const Mesh mesh = icosahedral_sphere(1);
+  std::vector<Vec3> X = mesh.nodes;
+  const auto& el = mesh.elements[11];
+  const Vec3 mid = 0.5 * (X[el[0]] + X[el[1]]);
+  X[el[3]] = mid - 0.28 * (X[el[1]] - X[el[0]]);  // 1 + 4 t = -0.12 at vertex 0 along the edge
+  for (ForceMethod method : {ForceMethod::Contour, ForceMethod::Energy}) {
+    const ElasticMembrane m(mesh, mesh.nodes, NeoHookean{1.0}, {}, method);
+    std::vector<Vec3> F;
+    EXPECT_THROW(m.compute_force(X, F), SimulationError);
+    EXPECT_NO_THROW(m.compute_energy(X));  // the quadrature points alone do not see it
+  }
+}
+
 TEST(MembraneForce, IdenticalForAnyThreadCount) {
   const Mesh mesh = icosahedral_sphere(2);
   const std::vector<Vec3> X = ellipsoid(mesh.nodes);
