@@ -163,8 +163,8 @@ TEST(RunUnstable, InvertedElementIsNamedWithItsAreaRatioAndItsDistanceToTheWall)
   ASSERT_EQ(r.status, 3) << r.out << r.err;
   const auto lines = lines_of(r.err);
   ASSERT_EQ(lines.size(), 2u) << r.err;
-  // immerse: run stopped: step 2, t = 1: membrane[0] element 2: Jacobian <= 0 or not finite (element inverted or
-  // degenerate); area ratio 0.619 (least of the membrane 0.619, element 10), 0.196 m from the wall z = 1
+  // immerse: run stopped: step 2, t = 1: membrane[0] element 1: Jacobian <= 0 or not finite (element inverted or
+  // degenerate); area ratio 1.36 (least of the membrane 0.619, element 10), 0.239 m from the wall y = 1
   const std::regex line(R"(immerse: run stopped: step (\d+), t = [0-9.e+-]+: membrane\[0\] element (\d+): Jacobian <= 0 )"
                         R"(or not finite \(element inverted or degenerate\); area ratio ([0-9.e+-]+) \(least of the )"
                         R"(membrane ([0-9.e+-]+), element (\d+)\), ([0-9.e+-]+) m from the wall ([xyz]) = ([01]))");
@@ -209,8 +209,8 @@ TEST(RunUnstable, RejectedStepNamesTheInvertedElementWithItsAreaRatioAndItsDista
   sets.push_back("time.max_speed=100.0");
   const auto r = run_immerse(run_args(scenario_file("oscillating_membrane_quick.toml"), dir / "out", sets), dir / "run");
   ASSERT_EQ(r.status, 0) << r.out << r.err;
-  // step 5, t = 8: step rejected with dt = 4 (membrane[0] element 1: Jacobian <= 0 or not finite (element inverted or
-  // degenerate); area ratio 3.62 (least of the membrane 0.969, element 2), 0.0447 m from the wall y = 1); retrying
+  // step 5, t = 8: step rejected with dt = 4 (membrane[0] element 0: Jacobian <= 0 or not finite (element inverted or
+  // degenerate); area ratio 1.54 (least of the membrane 0.969, element 2), 0.185 m from the wall x = 0); retrying
   // with dt = 2
   const std::regex line(R"(step \d+, t = [0-9.e+-]+: step rejected with dt = 4 \(membrane\[0\] element \d+: Jacobian <= 0 )"
                         R"(or not finite \(element inverted or degenerate\); area ratio [0-9.e+-]+ \(least of the membrane )"
