@@ -92,6 +92,7 @@ int main(int argc, char** argv) {
   try {
     app.parse(argc, argv);
     run_opts.command_line = immerse::io::Provenance::quote_command_line(argc, argv);
+    run_opts.program = argv[0];
   } catch (const CLI::ParseError& e) {
     if (e.get_exit_code() == 0) return app.exit(e);  // --help, --version
     std::cerr << "immerse: error: " << e.what() << " (see immerse --help)\n";

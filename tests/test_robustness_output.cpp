@@ -247,8 +247,8 @@ TEST(RobustnessOutput, FullDiskWhileWritingTheFinalCheckpointStopsWithStatus5) {
   EXPECT_EQ(read_csv(out / "diagnostics.csv").size(), 5u);  // header, steps 0..3
 }
 
-// An instability whose last checkpoint cannot be written: the instability is reported, then the failed write,
-// and the status is that of the failed write (5).
+// An instability whose unstable state cannot be written: the instability is reported, then the failed write, and
+// the status is that of the failed write (5).
 TEST(RobustnessOutput, FullDiskAfterAnInstabilityStopsWithStatus5) {
   ScratchDir scratch("output");
   const fs::path out = scratch / "out";
@@ -263,7 +263,8 @@ TEST(RobustnessOutput, FullDiskAfterAnInstabilityStopsWithStatus5) {
   const auto second = r.err.find('\n') + 1;
   EXPECT_EQ(r.err.rfind("immerse: run stopped: unstable at step ", 0), 0u) << r.err;
   EXPECT_EQ(r.err.find("immerse: run stopped at step ", second), second) << r.err;
-  EXPECT_NE(r.err.find("cannot write " + (out / "checkpoint.h5").string() + ": File too large (no checkpoint written)\n",
+  EXPECT_NE(r.err.find("cannot write " + (out / "unstable_state.h5").string() +
+                           ": File too large (no checkpoint written)\n",
                        second),
             std::string::npos)
       << r.err;

@@ -237,8 +237,8 @@ INSTANTIATE_TEST_SUITE_P(
         BadInput{"missing_mesh_file", "file_mesh.toml", {"membrane[0].mesh.file=\"no_such.msh\""}, "",
                  "membrane[0].mesh no_such.msh: cannot open the file"},
         BadInput{"checkpoint_of_other_grid", "", {"grid.nx=8", "grid.ny=8", "grid.nz=8"}, "good/checkpoint.h5",
-                 "checkpoint.h5 was written with grid.nx = 16 (on restart only time.end, scenario.kt_end, "
-                 "[output] and [solver] keys may change)"},
+                 "checkpoint.h5 was written with grid.nx = 16 (on restart only time.end, time.dt, time.dt_min, "
+                 "scenario.kt_end, scenario.k_dt, [output] and [solver] keys may change)"},
         BadInput{"corrupted_checkpoint", "", {}, "flipped.h5", "flipped.h5 is corrupted: checksum mismatch"},
         BadInput{"truncated_checkpoint", "", {}, "truncated.h5", "truncated.h5 is truncated or not an HDF5 file"},
         BadInput{"missing_checkpoint", "", {}, "no_such_checkpoint.h5", "no_such_checkpoint.h5"},

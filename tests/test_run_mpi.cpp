@@ -404,10 +404,89 @@ TEST(RunMpi, UnstableRunStopsEveryProcessWithStatus3AndItsLastState) {
   args.insert(args.end(), {"--set", "time.max_speed=3e-4"});  // the channel's flow reaches 3.6e-4 m/s in its centre
   const auto r = run_mpi(3, args, dir / "run");
   EXPECT_EQ(r.status, 3) << r.err;
-  EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+  EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 2) << r.err;
   EXPECT_EQ(r.err.rfind("immerse: run stopped: unstable at step 1, t = 2e-05: fluid velocity u_y", 0), 0u) << r.err;
-  // As in one process, the unstable state is saved for inspection.
-  EXPECT_EQ(io::Checkpoint::read(dir / "run" / "checkpoint.h5").get_int("step"), 1);
+  // As in one process, the unstable state is saved beside the checkpoint for inspection; none was due yet.
+  EXPECT_NE(r.err.find("\nimmerse: no checkpoint kept: none was written before step 1 (output.checkpoint_every = 3); "
+                       "the state of step 1 is in " + (dir / "run" / "unstable_state.h5").string() +
+                       "; start again with half the step: mpiexec -n 3 "),
+            std::string::npos)
+      << r.err;
+  EXPECT_FALSE(fs::exists(dir / "run" / "checkpoint.h5"));
+  EXPECT_EQ(io::Checkpoint::read(dir / "run" / "unstable_state.h5").get_int("step"), 1);
+}
+
+/// The words of the command at the end of the last line of an unstable run ("... with half the step: COMMAND").
+std::vector<std::string> suggested_command(const std::string& err) {
+  const std::string marker = " with half the step: ";
+  const auto at = err.rfind(marker);
+  if (at == std::string::npos) return {};
+  const auto end = err.find('\n', at);
+  return shell_words(err.substr(at + marker.size(), end == std::string::npos ? end : end - at - marker.size()));
+}
+
+// The small oscillating membrane (as kind "custom", which runs distributed) with the contour forces and forward Euler
+// past their explicit limit on 2 processes, a checkpoint every 2 steps: it runs away at step 9, checkpoint.h5 keeps
+// step 8, and the command of the last line, run as printed, continues with half the step to the end.
+TEST(RunMpi, UnstableRunKeepsTheLastGoodCheckpointAndContinuesWithHalfTheStep) {
+  ScratchDir dir("run_mpi");
+  const fs::path out = dir / "run";
+  const auto r = run_mpi(2,
+                         run_args(scenario_file("oscillating_membrane_quick.toml"), out,
+                                  {"scenario.kind=\"custom\"", "grid.nx=16", "grid.ny=16", "grid.nz=16",
+                                   "membrane[0].mesh.level=1", "membrane[0].force=\"contour\"", "time.scheme=\"euler\"",
+                                   "time.dt=0.35", "time.end=7.0", "time.max_speed=1.0", "output.fields_every=0",
+                                   "output.checkpoint_every=2"}),
+                         dir / "run");
+  ASSERT_EQ(r.status, 3) << r.err;
+  EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 2) << r.err;
+  std::smatch m;
+  ASSERT_TRUE(std::regex_search(r.err, m, std::regex(R"(^immerse: run stopped: unstable at step (\d+), t = )")))
+      << r.err;
+  const long step = std::stol(m[1]);
+  ASSERT_GE(step, 3) << "the run must become unstable after its first checkpoint";
+  const long kept = 2 * ((step - 1) / 2);
+  EXPECT_EQ(io::Checkpoint::read(out / "checkpoint.h5").get_int("step"), kept);
+  EXPECT_EQ(io::Checkpoint::read(out / "unstable_state.h5").get_int("step"), step);
+  EXPECT_NE(r.err.find("\nimmerse: kept the last good checkpoint " + (out / "checkpoint.h5").string() + " (step " +
+                       std::to_string(kept) + ", t = "),
+            std::string::npos)
+      << r.err;
+
+  // mpiexec -n 2 PROGRAM run FILE --out DIR ... --restart DIR/checkpoint.h5 --set time.dt=0.175
+  const auto words = suggested_command(r.err);
+  ASSERT_GE(words.size(), 5u) << r.err;
+  EXPECT_EQ(std::vector<std::string>(words.begin(), words.begin() + 4),
+            (std::vector<std::string>{"mpiexec", "-n", "2", immerse_program().string()}));
+  EXPECT_EQ(words.back(), "time.dt=0.175");
+  const auto again = run_mpi(2, {words.begin() + 4, words.end()}, dir / "again");
+  ASSERT_EQ(again.status, 0) << again.err;
+  const io::Checkpoint last = io::Checkpoint::read(out / "checkpoint.h5");
+  EXPECT_EQ(last.get_int("step"), kept + std::lround((7.0 - 0.35 * double(kept)) / 0.175));
+  EXPECT_NEAR(last.get_double("fluid.time"), 7.0, 1e-9);
+  EXPECT_FALSE(fs::exists(out / "unstable_state.h5"));
+}
+
+// Forward Euler at 2e-4 s folds an element of a cell of the quick channel: on 2 processes the message names it with
+// its area ratio, the wall and the nearest other cell (searched on every process), as the one-process run does.
+TEST(RunMpi, InvertedElementIsNamedAsInOneProcess) {
+  ScratchDir dir("run_mpi");
+  const auto args = [&](const std::string& name) {
+    return run_args(scenario_file("rbc_channel_quick.toml"), dir / name,
+                    {"time.scheme=\"euler\"", "time.dt=2e-4", "time.end=0.02", "output.fields_every=0",
+                     "output.checkpoint_every=0"});
+  };
+  const auto two = run_mpi(2, args("two"), dir / "two");
+  const auto one = run_immerse(args("one"), dir / "one");
+  ASSERT_EQ(two.status, 3) << two.err;
+  ASSERT_EQ(one.status, 3) << one.err;
+  const std::string first = two.err.substr(0, two.err.find('\n'));
+  EXPECT_EQ(first, one.err.substr(0, one.err.find('\n')));
+  const std::regex line(R"(immerse: run stopped: step \d+, t = [0-9.e+-]+: membrane\[\d+\] element \d+: Jacobian <= 0 )"
+                        R"(or not finite \(element inverted or degenerate\); area ratio [0-9.e+-]+ \(least of the )"
+                        R"(membrane [0-9.e+-]+, element \d+\), [0-9.e+-]+ m from the wall [xz] = [0-9.e+-]+, )"
+                        R"([0-9.e+-]+ m from membrane\[\d+\])");
+  EXPECT_TRUE(std::regex_match(first, line)) << first;
 }
 
 TEST(RunMpi, StopSignalToOneProcessStopsAllAfterTheSameStepWithACheckpoint) {

@@ -189,6 +189,34 @@ inline std::string file_membrane_toml(const std::string& mesh, const std::string
          "\"\ncenter = [0.5, 0.5, 0.5]\nEs = 0.1\n" + extra;
 }
 
+/// The words of a command line as a POSIX shell splits it, for the lines the program quotes (plain words and single
+/// quotes, each ' inside written as '\'').
+inline std::vector<std::string> shell_words(const std::string& line) {
+  std::vector<std::string> words;
+  std::string word;
+  bool in_word = false;
+  for (std::size_t i = 0; i < line.size(); ++i) {
+    const char c = line[i];
+    if (c == ' ') {
+      if (in_word) words.push_back(word), word.clear();
+      in_word = false;
+    } else if (c == '\'') {
+      const std::size_t end = line.find('\'', i + 1);
+      word += line.substr(i + 1, end - i - 1);
+      i = end;
+      in_word = true;
+    } else if (c == '\\' && i + 1 < line.size()) {
+      word += line[++i];
+      in_word = true;
+    } else {
+      word += c;
+      in_word = true;
+    }
+  }
+  if (in_word) words.push_back(word);
+  return words;
+}
+
 /// The command line `run FILE --out DIR --set ...`.
 inline std::vector<std::string> run_args(const fs::path& file, const fs::path& out, const std::vector<std::string>& sets,
                                          const fs::path& restart = {}) {

@@ -24,6 +24,7 @@
 #include "immerse/app/ShearPlaneProfile.hpp"
 #include "immerse/app/StopSignals.hpp"
 #include "immerse/app/SuspensionShearRun.hpp"
+#include "immerse/app/UnstableStop.hpp"
 #include "immerse/core/Error.hpp"
 #include "immerse/core/MemoryLimits.hpp"
 #include "immerse/core/ThreadGovernor.hpp"
@@ -452,6 +453,7 @@ class DistributedLoop {
         shear_rate_(shear_rate(sim.config())),
         root_(root),
         provenance_(std::move(provenance)),
+        options_(options),
         dir_(options.out),
         out_(out),
         err_(err),
@@ -466,6 +468,7 @@ class DistributedLoop {
       if (restarted && (in_place || !s->at_start)) s->last_step = sim.step();
     last_.step = sim.step();
     last_.time = sim.time();
+    if (restarted) kept_ = {options.restart, sim.step(), sim.time(), in_place};
   }
 
   int run() {
@@ -478,11 +481,12 @@ class DistributedLoop {
       progress_.finish();
       err_ << "immerse: run stopped: " << e.what() << "\n";
       status_ = 3;
+      unstable_ = true;
     } catch (const WriteError& e) {
       write_failed(e);
     }
     progress_.finish();
-    // The last state is saved, as in one process (after an instability: the unstable state, for inspection).
+    // The last state is saved, as in one process (after an instability to unstable_state.h5, for inspection).
     if (status_ != 5) try {
         for (auto [s, act] : actions()) {
           if (!s->at_end || s->last_step == sim_.step()) continue;
@@ -491,11 +495,14 @@ class DistributedLoop {
           } catch (const SimulationError& e) {
             err_ << "immerse: " << name(s) << " of step " << sim_.step() << " not written: " << e.what() << "\n";
             status_ = 3;
+            unstable_ = true;
           }
         }
       } catch (const WriteError& e) {
         write_failed(e);
       }
+    if (status_ == 3)
+      err_ << unstable_stop_line(options_, sim_.config(), kept_, sim_.step(), unstable_written_, comm_.size());
     if (status_ == 4)
       err_ << "immerse: interrupted by signal " << signal_ << " at step " << sim_.step() << ", t = " << sim_.time()
            << "; checkpoint written to " << (dir_ / "checkpoint.h5").string() << "\n";
@@ -529,8 +536,21 @@ class DistributedLoop {
       case Action::Checkpoint: {
         io::ParallelCheckpoint ck = checkpoint_of(sim_);
         ck.set_attributes(provenance_.attributes());
+        if (unstable_) {
+          ck.write(unstable_state_file(dir_));
+          unstable_written_ = true;
+          break;
+        }
         ck.write(dir_ / "checkpoint.h5");
         checkpoint_step_ = sim_.step();
+        kept_ = {dir_ / "checkpoint.h5", sim_.step(), sim_.time(), true};
+        // Newer than the unstable state of an attempt this run continues: that post-mortem file goes.
+        if (!stale_unstable_removed_) on_root([&] {
+            std::error_code ec;
+            std::filesystem::remove(unstable_state_file(dir_), ec);
+            if (ec) throw WriteError("cannot remove " + unstable_state_file(dir_).string() + ": " + ec.message());
+          });
+        stale_unstable_removed_ = true;
         break;
       }
     }
@@ -626,6 +646,7 @@ class DistributedLoop {
   double shear_rate_;
   RootOutput* root_;
   io::Provenance provenance_;
+  const RunOptions& options_;
   std::filesystem::path dir_;
   std::ostream& out_;
   std::ostream& err_;
@@ -636,6 +657,8 @@ class DistributedLoop {
   int status_ = 0, signal_ = 0;
   long steps_ = 0, checkpoint_step_ = -1;
   double stepping_ = 0;
+  KeptCheckpoint kept_;  ///< where the run can continue from (no file: start again)
+  bool unstable_ = false, unstable_written_ = false, stale_unstable_removed_ = false;
 };
 
 /// The provenance of rank 0 (its host and start time), the same on every process: HDF5 attributes written

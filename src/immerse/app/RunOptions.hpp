@@ -14,6 +14,7 @@ struct RunOptions {
   bool overwrite = false;         ///< remove the run files of another run in `out` first
   bool verbose = false;           ///< print the whole resolved configuration before the run
   std::string command_line;       ///< recorded in the run folder (Provenance); "immerse run FILE" if empty
+  std::string program = "immerse";  ///< as started (argv[0]), for the commands a stopped run suggests
 };
 
 }  // namespace immerse

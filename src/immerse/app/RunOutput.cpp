@@ -4,6 +4,7 @@
 #include <ostream>
 #include <string>
 
+#include "immerse/app/UnstableStop.hpp"
 #include "immerse/core/Error.hpp"
 #include "immerse/io/AtomicFile.hpp"
 #include "immerse/io/TomlFormat.hpp"
@@ -110,7 +111,9 @@ RunOutput::RunOutput(const RunOptions& options, const Simulation& sim, const Run
       folder_(dir_),
       diagnostics_(sim.config(), sim.num_membranes(), scenario),
       diagnostics_table_("diagnostics", diagnostics_.columns(),
-                         [this](long, double step) { return step <= double(sim_.step()); }) {
+                         [this](long, double step) { return step <= double(sim_.step()); }),
+      start_step_(sim.step()),
+      start_time_(sim.time()) {
   if (const auto found = folder_.run_files(); !found.empty() && !in_place_ && !options.overwrite) {
     std::string names;
     for (std::size_t i = 0; i < std::min<std::size_t>(found.size(), 3); ++i) names += (i ? ", " : "") + found[i];
@@ -184,14 +187,36 @@ Callback RunOutput::fields_callback() {
           [this](const Simulation& s) { write_frame(*frames_, s, settings_.fluid_fields); }};
 }
 
+// A checkpoint is newer than the unstable state of an attempt this run continues: that post-mortem file goes.
 Callback RunOutput::checkpoint_callback() {
   return {"checkpoint", settings_.checkpoint_every, false, true, [this](const Simulation& s) {
             io::Checkpoint ck = s.checkpoint();
             scenario_.save(ck);
             ck.set_attributes(provenance_.attributes());
+            if (unstable_) {
+              ck.write(unstable_state_file(dir_));
+              unstable_written_ = true;
+              return;
+            }
             ck.write(checkpoint_file());
             checkpoint_step_ = s.step();
+            checkpoint_time_ = s.time();
+            if (!stale_unstable_removed_) {
+              std::error_code ec;
+              std::filesystem::remove(unstable_state_file(dir_), ec);
+              if (ec) throw WriteError("cannot remove " + unstable_state_file(dir_).string() + ": " + ec.message());
+              stale_unstable_removed_ = true;
+            }
           }};
+}
+
+std::string RunOutput::unstable_stop_line() const {
+  KeptCheckpoint kept;
+  if (checkpoint_step_ >= 0)
+    kept = {checkpoint_file(), checkpoint_step_, checkpoint_time_, true};
+  else if (restarted_)
+    kept = {options_.restart, start_step_, start_time_, in_place_};
+  return immerse::unstable_stop_line(options_, sim_.config(), kept, sim_.step(), unstable_written_);
 }
 
 void RunOutput::discard() const {

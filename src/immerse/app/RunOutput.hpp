@@ -5,6 +5,7 @@
 #include <filesystem>
 #include <iosfwd>
 #include <optional>
+#include <string>
 #include <vector>
 
 #include "immerse/app/Callback.hpp"
@@ -42,6 +43,11 @@ class RunOutput {
   std::filesystem::path checkpoint_file() const { return dir_ / "checkpoint.h5"; }
   /// The step of the last checkpoint this run wrote (-1: none).
   long last_checkpoint_step() const { return checkpoint_step_; }
+  /// The run became unstable: from now on the checkpoint callback saves the state to unstable_state.h5 and leaves
+  /// checkpoint.h5 as it was.
+  void stop_unstable() { unstable_ = true; }
+  /// The last line of a run stopped by an instability (UnstableStop.hpp).
+  std::string unstable_stop_line() const;
 
  private:
   Callback diagnostics_callback(const StepRecord& last);
@@ -63,6 +69,10 @@ class RunOutput {
   io::Provenance provenance_;  ///< from create() on
   std::optional<io::XdmfWriter> frames_;
   long checkpoint_step_ = -1;
+  double checkpoint_time_ = 0;
+  long start_step_;  ///< of the state the run began from (a restart's checkpoint)
+  double start_time_;
+  bool unstable_ = false, unstable_written_ = false, stale_unstable_removed_ = false;
 };
 
 }  // namespace immerse

@@ -42,6 +42,7 @@ int TimeLoop::run() {
     progress_.finish();
     err_ << "immerse: run stopped: " << e.what() << "\n";
     status_ = 3;
+    output_.stop_unstable();
   } catch (const StopRequested&) {
     status_ = 4;  // while a rejected step was to be retried: the state is the last accepted step's
   } catch (const WriteError& e) {
@@ -56,7 +57,7 @@ int TimeLoop::run() {
   progress_.finish();
   // A failure to save the last state is a failed write too (exit 5). A last state the membranes cannot be evaluated
   // in (an element that a volume correction turned over, say) loses the output that needs its forces, not the rest:
-  // the checkpoint is still written and the run counts as stopped by the numerics (exit 3).
+  // it is saved as the unstable state and the run counts as stopped by the numerics (exit 3).
   if (status_ != 5) try {
       for (auto& c : callbacks_) {
         if (!c.at_end || c.last_step == sim_.step()) continue;
@@ -65,11 +66,13 @@ int TimeLoop::run() {
         } catch (const SimulationError& e) {
           err_ << "immerse: " << c.name << " of step " << sim_.step() << " not written: " << e.what() << "\n";
           status_ = 3;
+          output_.stop_unstable();
         }
       }
     } catch (const WriteError& e) {
       write_failed(e);
     }
+  if (status_ == 3) err_ << output_.unstable_stop_line();
   if (status_ == 4)
     err_ << "immerse: interrupted by signal " << StopSignals::received() << " at step " << sim_.step() << ", t = "
          << sim_.time() << "; checkpoint written to " << output_.checkpoint_file().string() << "\n";

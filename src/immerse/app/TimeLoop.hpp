@@ -1,7 +1,8 @@
 #pragma once
 // The time loop of `immerse run`: steps until time.end, the scenario's end or a stop signal, with the scenario's work
 // and the output callbacks after each step, and turns what ended the run into its exit status. The last state is
-// always saved (after an instability: the unstable state, for inspection), unless writing is what failed.
+// always saved, unless writing is what failed: after an instability to unstable_state.h5, for inspection, leaving
+// checkpoint.h5 at the last good step (UnstableStop.hpp).
 #include <iosfwd>
 #include <string>
 #include <vector>

@@ -1,5 +1,6 @@
 #include "immerse/simulation/CheckpointEntries.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <sstream>
 
@@ -14,12 +15,14 @@ void check_checkpoint_configuration(const io::Config& config, const io::Checkpoi
   io::Config theirs = config.schema().parse_string(ck.get_string("config"), "checkpoint");
   leave_out_inapplicable(theirs);
   const auto may_change = [](const std::string& key) {
-    return key == "time.end" || key == "scenario.kt_end" || key.starts_with("output.") || key.starts_with("solver.") ||
-           key == "mesh.file" || key == "mesh.reference_file";
+    return key == "time.end" || key == "scenario.kt_end" || key == "time.dt" || key == "scenario.k_dt" ||
+           key == "time.dt_min" || key.starts_with("output.") || key.starts_with("solver.") || key == "mesh.file" ||
+           key == "mesh.reference_file";
   };
   const auto differ = [&](const std::string& key, const std::string& was, const std::string& is) {
     throw InputError(key + " = " + is + ": the checkpoint " + ck.source() + " was written with " + key + " = " + was +
-                     " (on restart only time.end, scenario.kt_end, [output] and [solver] keys may change)");
+                     " (on restart only time.end, time.dt, time.dt_min, scenario.kt_end, scenario.k_dt, [output] and "
+                     "[solver] keys may change)");
   };
   for (const auto& k : config.schema().keys())
     if (!may_change(k.key) && theirs.value_text(k.key) != config.value_text(k.key))
@@ -35,6 +38,14 @@ void check_checkpoint_configuration(const io::Config& config, const io::Checkpoi
         if (was != is) differ(t.name + "[" + std::to_string(i) + "]." + k.key, was, is);
       }
   }
+}
+
+double continued_step(const io::Config& config, const io::Checkpoint& ck) {
+  const io::Config theirs = config.schema().parse_string(ck.get_string("config"), "checkpoint");
+  const double dt = ck.get_double("stepper.dt");
+  CheckpointEntries(ck).number("stepper.dt", dt, std::isfinite(dt) && dt > 0 && dt <= theirs.get<double>("time.dt"),
+                               "in (0, time.dt]");
+  return std::min(dt, config.get<double>("time.dt"));
 }
 
 double CheckpointEntries::number(const std::string& name, double v, bool ok, const std::string& allowed) const {

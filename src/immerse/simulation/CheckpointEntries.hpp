@@ -12,9 +12,13 @@
 
 namespace immerse {
 
-/// InputError naming the first key whose value differs from the checkpoint's configuration (time.end,
-/// scenario.kt_end, [output] and [solver] keys and the names of mesh files may differ).
+/// InputError naming the first key whose value differs from the checkpoint's configuration (time.end, time.dt,
+/// time.dt_min, scenario.kt_end, scenario.k_dt, [output] and [solver] keys and the names of mesh files may differ).
 void check_checkpoint_configuration(const io::Config& config, const io::Checkpoint& ck);
+
+/// The step the run continues with: the checkpoint's stepper.dt (InputError unless in (0, time.dt] of the
+/// checkpoint's own configuration), at most time.dt of `config` (a restart may take a smaller step).
+double continued_step(const io::Config& config, const io::Checkpoint& ck);
 
 /// The checked getters of one checkpoint.
 class CheckpointEntries {

@@ -3,11 +3,15 @@
 #include <mpi.h>
 
 #include <algorithm>
+#include <array>
+#include <optional>
 #include <stdexcept>
 #include <utility>
 
 #include "immerse/core/Error.hpp"
 #include "immerse/coupling/NodeDiagnostics.hpp"
+#include "immerse/parallel/Agreement.hpp"
+#include "immerse/simulation/InversionReport.hpp"
 
 namespace immerse {
 
@@ -91,20 +95,72 @@ void DistributedOperator::nodal_forces(std::span<const Vec3> Xf) {
   F_.resize(Xf.size());
   Fm_.resize(owned.size());
   std::string error;
+  std::size_t failed = owned.size();
   for (std::size_t k = 0; k < owned.size() && error.empty(); ++k) {
     const std::span<const Vec3> Xm = Xf.subspan(offset_[k], offset_[k + 1] - offset_[k]);
     try {
       check_nodes_in_domain(fluid_.grid(), Xm);
       membranes_[static_cast<std::size_t>(owned[k].id)]->compute_force(Xm, Fm_[k]);
     } catch (const SimulationError& e) {
-      error = "membrane[" + std::to_string(owned[k].id) + "] " + e.what();
+      error = e.what();
+      failed = k;
     }
     if (error.empty()) std::copy(Fm_[k].begin(), Fm_[k].end(), F_.begin() + static_cast<std::ptrdiff_t>(offset_[k]));
   }
   if (any_failed(fluid_.decomposition().communicator(), !error.empty()))
-    throw SimulationError(error.empty() ? std::string("a membrane of another process failed") : error);
+    throw SimulationError(failure_report(Xf, failed, error));
   // After the membranes, which have checked that every node is finite and inside the box.
   if (contact_.range > 0) add_contact_forces(Xf);
+}
+
+// The lowest-ranked failing process's message on every process; for an inverted element, with where it stands, the
+// nearest node of another membrane searched on every process (each over the membranes it owns).
+std::string DistributedOperator::failure_report(std::span<const Vec3> Xf, std::size_t failed,
+                                                const std::string& error) const {
+  const Communicator& comm = fluid_.decomposition().communicator();
+  const auto& owned = ownership_.owned();
+  const std::optional<std::size_t> element = error.empty() ? std::nullopt : inverted_element(error);
+  // Per process: whether it failed, then for an inversion the membrane, the element and its six nodes.
+  constexpr std::size_t kRecord = 21;
+  std::vector<double> mine(kRecord, 0.0);
+  std::span<const Vec3> Xm;
+  if (!error.empty()) {
+    mine[0] = element ? 2 : 1;
+    Xm = Xf.subspan(offset_[failed], offset_[failed + 1] - offset_[failed]);
+  }
+  if (element) {
+    const auto id = static_cast<std::size_t>(owned[failed].id);
+    mine[1] = static_cast<double>(id);
+    mine[2] = static_cast<double>(*element);
+    const auto nodes = nodes_of_element(*membranes_[id], Xm, *element);
+    for (std::size_t i = 0; i < nodes.size(); ++i)
+      for (int a = 0; a < 3; ++a) mine[3 + 3 * i + static_cast<std::size_t>(a)] = nodes[i][a];
+  }
+  const std::vector<double> all = comm.all_gather(mine);
+  std::size_t first = 0;
+  while (all[kRecord * first] == 0) ++first;  // a process failed: any_failed said so
+  std::string details;
+  if (all[kRecord * first] == 2) {
+    const double* record = &all[kRecord * first];
+    const auto id = static_cast<std::size_t>(record[1]), inverted = static_cast<std::size_t>(record[2]);
+    std::array<Vec3, 6> nodes;
+    for (std::size_t i = 0; i < nodes.size(); ++i) nodes[i] = {record[3 + 3 * i], record[4 + 3 * i], record[5 + 3 * i]};
+    NearestMembrane nearest;
+    for (std::size_t k = 0; k < owned.size(); ++k)
+      if (static_cast<std::size_t>(owned[k].id) != id)
+        nearest.consider(fluid_.grid(), nodes, Xf.subspan(offset_[k], offset_[k + 1] - offset_[k]),
+                         static_cast<std::size_t>(owned[k].id));
+    const std::vector<double> candidates =
+        comm.all_gather(std::vector<double>{nearest.distance, static_cast<double>(nearest.membrane)});
+    for (std::size_t p = 0; p < candidates.size(); p += 2)
+      if (candidates[p] < nearest.distance ||
+          (candidates[p] == nearest.distance && candidates[p + 1] < static_cast<double>(nearest.membrane)))
+        nearest = {candidates[p], static_cast<std::size_t>(candidates[p + 1])};
+    if (static_cast<std::size_t>(comm.rank()) == first)
+      details = inversion_details(fluid_.grid(), *membranes_[id], Xm, inverted, nearest);
+  }
+  const std::string named = error.empty() ? error : "membrane[" + std::to_string(owned[failed].id) + "] " + error + details;
+  return first_error(comm, named);
 }
 
 void DistributedOperator::add_contact_forces(std::span<const Vec3> Xf) {

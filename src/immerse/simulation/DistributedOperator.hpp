@@ -113,6 +113,9 @@ class DistributedOperator final : public CoupledOperator {
   void refresh();
   /// F = f(Xf) at the owned nodes: membrane forces, then the contact forces added. Collective.
   void nodal_forces(std::span<const Vec3> Xf);
+  /// The message every process throws once a membrane failed at Xf: `error` of owned membrane `failed` on a process
+  /// where one failed (empty elsewhere). Collective.
+  std::string failure_report(std::span<const Vec3> Xf, std::size_t failed, const std::string& error) const;
   /// Adds the contact forces of the owned nodes at Xf to F_. Collective.
   void add_contact_forces(std::span<const Vec3> Xf);
   /// Forces at Xf, spreading and the fluid step into trial_ driven by F^{n+1/2} of (Xf, theta). Collective.

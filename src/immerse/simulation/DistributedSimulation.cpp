@@ -259,9 +259,7 @@ void DistributedSimulation::restore(const io::Checkpoint& ck) {
   if (guess_errors.size() % std::max<std::size_t>(unknowns, 1) != 0)
     ck.invalid(errors, "has " + std::to_string(guess_errors.size()) + " values, not a multiple of the " +
                            std::to_string(unknowns) + " unknowns");
-  const double dt = ck.get_double("stepper.dt");
-  entries.number("stepper.dt", dt, std::isfinite(dt) && dt > 0 && dt <= config_.get<double>("time.dt"),
-                 "in (0, time.dt]");
+  const double dt = continued_step(config_, ck);
   const std::int64_t successes = entries.count("stepper.successes");
   const std::int64_t step = entries.count("step");
   if (f.time >= end_time_ * (1 - 1e-12)) {

@@ -14,6 +14,7 @@
 #include "immerse/core/Parallel.hpp"
 #include "immerse/fluid/MacStencilGrid.hpp"
 #include "immerse/coupling/NodeDiagnostics.hpp"
+#include "immerse/simulation/InversionReport.hpp"
 #include "immerse/timestep/LogEvent.hpp"
 
 namespace immerse {
@@ -118,7 +119,15 @@ void ImmersedBoundaryOperator::nodal_force(std::size_t m, std::span<const Vec3> 
     check_nodes_in_domain(fluid_.grid(), Xm);
     membranes_[m]->compute_force(Xm, Fm_[m]);
   } catch (const SimulationError& e) {
-    throw SimulationError("membrane[" + std::to_string(m) + "] " + e.what());
+    std::string details;
+    if (const auto element = inverted_element(e.what())) {
+      NearestMembrane nearest;
+      const auto nodes = nodes_of_element(*membranes_[m], Xm, *element);
+      for (std::size_t o = 0; o < membranes_.size(); ++o)
+        if (o != m) nearest.consider(fluid_.grid(), nodes, X.subspan(offset_[o], offset_[o + 1] - offset_[o]), o);
+      details = inversion_details(fluid_.grid(), *membranes_[m], Xm, *element, nearest);
+    }
+    throw SimulationError("membrane[" + std::to_string(m) + "] " + e.what() + details);
   }
   for (std::size_t i = 0; i < Fm_[m].size(); ++i) F_[offset_[m] + i] = Fm_[m][i] + applied_[offset_[m] + i];
 }

@@ -197,9 +197,6 @@ io::Checkpoint Simulation::checkpoint() const {
 void Simulation::restore(const io::Checkpoint& ck) {
   check_checkpoint_configuration(config_, ck);
   const CheckpointEntries entries(ck);
-  const auto number = [&](const std::string& name, double v, bool ok, const std::string& allowed) {
-    return entries.number(name, v, ok, allowed);
-  };
   const auto count = [&](const std::string& name) { return entries.count(name); };
   const auto time_value = [&](const std::string& name) { return entries.time_value(name); };
   const auto array = [&](const std::string& name, std::size_t size) -> const std::vector<double>& {
@@ -244,8 +241,7 @@ void Simulation::restore(const io::Checkpoint& ck) {
   const std::string errors = "integrator.guess_errors";
   const std::vector<double> guess_errors =
       ck.has(errors) ? array(errors, ck.array(errors).size()) : std::vector<double>{};
-  const double nominal = config_.get<double>("time.dt"), dt = ck.get_double("stepper.dt");
-  number("stepper.dt", dt, std::isfinite(dt) && dt > 0 && dt <= nominal, "in (0, time.dt]");
+  const double dt = continued_step(config_, ck);
   const std::int64_t successes = count("stepper.successes");
   const std::int64_t step = count("step");
   const double end = config_.get<double>("time.end");
