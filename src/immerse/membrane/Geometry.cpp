@@ -134,7 +134,10 @@ double area(const Mesh& mesh, const std::vector<Vec3>& X) {
 }
 
 LeastAreaRatio least_area_ratio(const Mesh& mesh, std::span<const Vec3> X, std::span<const double> reference_areas) {
-  const auto a = element_areas(mesh, X);
+  return least_area_ratio(element_areas(mesh, X), reference_areas);
+}
+
+LeastAreaRatio least_area_ratio(std::span<const double> a, std::span<const double> reference_areas) {
   LeastAreaRatio least{std::numeric_limits<double>::infinity(), 0};
   for (std::size_t e = 0; e < a.size(); ++e)
     if (const double r = a[e] / reference_areas[e]; r < least.ratio) least = {r, e};

@@ -51,6 +51,8 @@ struct LeastAreaRatio {
   std::size_t element = 0;
 };
 LeastAreaRatio least_area_ratio(const Mesh& mesh, std::span<const Vec3> X, std::span<const double> reference_areas);
+/// The same from the element areas already measured.
+LeastAreaRatio least_area_ratio(std::span<const double> areas, std::span<const double> reference_areas);
 /// Enclosed volume (positive for outward-oriented elements).
 double volume(const Mesh& mesh, const std::vector<Vec3>& X);
 /// Inertia tensor I = ∫_V (|r|² 1 - r rᵀ) dV of the enclosed volume with unit density, r from the

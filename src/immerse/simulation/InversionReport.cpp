@@ -4,6 +4,7 @@
 #include <cmath>
 #include <iomanip>
 #include <sstream>
+#include <vector>
 
 #include "immerse/membrane/Geometry.hpp"
 
@@ -43,8 +44,9 @@ std::string inversion_details(const Grid& grid, const ElasticMembrane& membrane,
                               std::size_t element, const NearestMembrane& nearest) {
   const Mesh mesh{{}, membrane.elements()};
   const auto reference = membrane.reference_element_areas();
-  const double ratio = element_areas(mesh, X)[element] / reference[element];
-  const LeastAreaRatio least = least_area_ratio(mesh, X, reference);
+  const std::vector<double> areas = element_areas(mesh, X);
+  const double ratio = areas[element] / reference[element];
+  const LeastAreaRatio least = least_area_ratio(areas, reference);
   std::ostringstream s;
   s.precision(3);
   s << "; area ratio " << ratio << " (least of the membrane " << least.ratio << ", element " << least.element << ")";
