@@ -271,6 +271,8 @@ INSTANTIATE_TEST_SUITE_P(
                  "membrane[0].Es = -0.1: must be a finite number > 0"},
         BadInput{"negative_volume_modulus", "", {"membrane[0].volume_modulus=-1"}, "",
                  "membrane[0].volume_modulus = -1: must be a finite number >= 0"},
+        BadInput{"negative_dilation_modulus", "", {"membrane[0].dilation_modulus=-1"}, "",
+                 "membrane[0].dilation_modulus = -1: must be a finite number >= 0"},
         BadInput{"unknown_volume_correction", "", {"membrane[0].volume_correction=\"rescale\""}, "",
                  "membrane[0].volume_correction = \"rescale\": must be one of"},
         BadInput{"zero_time_step", "", {"time.dt=0"}, "", "time.dt = 0: must be a finite number > 0"},

@@ -88,26 +88,31 @@ Nodes element_nodes(const std::array<int, 6>& el, std::span<const Vec3> X) {
   return x;
 }
 
-/// Jacobian signed against the element's chord normal (x1 - x0) x (x2 - x0): an inverted, folded or
-/// degenerate element has a point where it is <= 0 (or not finite).
-[[gnu::always_inline]] inline bool jacobian_ok(const Tangents& t, const Vec3& chord) {
-  const double s = dot(cross(t.a_xi, t.a_eta), chord);
+/// Jacobian signed against the element's own normal at its centroid, a_xi x a_eta at (1/3, 1/3): an inverted,
+/// folded or degenerate element has a point where it is <= 0 (or not finite). The flat triangle through the three
+/// vertices is no reference for a curved element: its mid-side nodes shape the surface, and on a cell's rim the
+/// vertices' plane can lie 70 degrees off the surface the element describes (docs/membrane-bending.md).
+[[gnu::always_inline]] inline bool jacobian_ok(const Tangents& t, const Vec3& own) {
+  const double s = dot(cross(t.a_xi, t.a_eta), own);
   return s > 0 && std::isfinite(s);
 }
 
-[[gnu::always_inline]] inline Vec3 chord_normal(const Nodes& x) { return cross(x[1] - x[0], x[2] - x[0]); }
-[[gnu::always_inline]] inline Vec3 chord_normal(const std::array<int, 6>& el, std::span<const Vec3> X) {
-  return cross(X[el[1]] - X[el[0]], X[el[2]] - X[el[0]]);
+/// a_xi x a_eta at the centroid: N_k derivatives at xi = eta = 1/3 are (-1/3, 1/3, 0, 0, 4/3, -4/3) along xi and
+/// (-1/3, 0, 1/3, -4/3, 4/3, 0) along eta.
+[[gnu::always_inline]] inline Vec3 centroid_normal(const Nodes& x) {
+  const Vec3 a_xi = (x[1] - x[0]) * (1.0 / 3) + (x[4] - x[5]) * (4.0 / 3);
+  const Vec3 a_eta = (x[2] - x[0]) * (1.0 / 3) + (x[4] - x[3]) * (4.0 / 3);
+  return cross(a_xi, a_eta);
 }
 
-/// The Jacobian signed against the chord normal at the six element nodes, where a curved element folds first (a
+/// The Jacobian signed against the centroid normal at the six element nodes, where a curved element folds first (a
 /// mid-side node past the quarter point of its edge makes it vanish at a vertex while the quadrature points still
 /// see a positive one). The energy method checks these too, so that it accepts the states node_pass accepts.
-[[gnu::always_inline]] inline bool element_nodes_ok(const Nodes& x, const Vec3& chord) {
+[[gnu::always_inline]] inline bool element_nodes_ok(const Nodes& x, const Vec3& own) {
   for (int k = 0; k < 6; ++k) {
     Tangents t;
     node_derivatives(k, [&](int j) { return x[j]; }, t.a_xi, t.a_eta);
-    if (!jacobian_ok(t, chord)) return false;
+    if (!jacobian_ok(t, own)) return false;
   }
   return true;
 }
@@ -213,11 +218,11 @@ ElasticMembrane::ElasticMembrane(const Mesh& mesh, std::vector<Vec3> reference, 
   ref_quad_.resize(4 * tri6::kQuadPoints * E);
   for (std::size_t e = 0; e < E; ++e) {
     const Nodes x = element_nodes(elements_[e], reference_);
-    const Vec3 chord = chord_normal(x);
+    const Vec3 own = centroid_normal(x);
     for (int k = 0; k < 6; ++k) {
       const Tangents t = membrane_k::tangents(x, kNodeShape[k]);
       const Tangents tq = membrane_k::tangents(x, kQuadShape[k]);
-      require(jacobian_ok(t, chord) && jacobian_ok(tq, chord), "membrane reference element " + std::to_string(e),
+      require(jacobian_ok(t, own) && jacobian_ok(tq, own), "membrane reference element " + std::to_string(e),
               "non-degenerate and counter-clockwise seen from outside (Jacobian > 0)");
       store_metric(ref_node_, 6 * e + k, membrane_k::ref_metric(t));
       store_metric(ref_quad_, 6 * e + k, membrane_k::ref_metric(tq));
@@ -240,7 +245,7 @@ void ElasticMembrane::check_size(std::span<const Vec3> X) const {
 // evaluated at that element node, and the result does not depend on the thread count.
 
 // Normal n and (optionally) tension (17)-(20), (18) from (39) at each element node, averaged at the nodes. The
-// element-node values are computed element by element (an element's six nodes gathered once, its chord normal
+// element-node values are computed element by element (an element's six nodes gathered once, its centroid normal
 // once) into per-slot arrays, then averaged node by node.
 void ElasticMembrane::node_pass(std::span<const Vec3> X, bool with_tension, Work& w) const {
   const int N = static_cast<int>(num_nodes()), E = static_cast<int>(num_elements());
@@ -252,13 +257,13 @@ void ElasticMembrane::node_pass(std::span<const Vec3> X, bool with_tension, Work
 #pragma omp parallel for schedule(static) reduction(min : bad) if (threaded_)
         for (int e = 0; e < E; ++e) {
           const Nodes x = element_nodes(elements_[e], X);
-          const Vec3 chord = chord_normal(x);
+          const Vec3 own = centroid_normal(x);
           for (int k = 0; k < 6; ++k) {
             const int slot = 6 * e + k;
             Tangents t;
             node_derivatives(k, [&](int j) { return x[j]; }, t.a_xi, t.a_eta);
             const Vec3 c = cross(t.a_xi, t.a_eta);  // J n, as in membrane_k::frame (dual basis not needed here)
-            if (!jacobian_ok(t, chord)) {
+            if (!jacobian_ok(t, own)) {
               bad = std::min(bad, e);
               break;
             }
@@ -374,8 +379,8 @@ void ElasticMembrane::energy_forces(std::span<const Vec3> X, Work& w) const {
 #pragma omp parallel for schedule(static) reduction(min : bad) if (threaded_)
         for (int e = 0; e < E; ++e) {
           const Nodes x = element_nodes(elements_[e], X);
-          const Vec3 chord = chord_normal(x);
-          if (!element_nodes_ok(x, chord)) {
+          const Vec3 own = centroid_normal(x);
+          if (!element_nodes_ok(x, own)) {
             bad = std::min(bad, e);
             continue;
           }
@@ -383,7 +388,7 @@ void ElasticMembrane::energy_forces(std::span<const Vec3> X, Work& w) const {
           for (int q = 0; q < tri6::kQuadPoints; ++q) {
             const tri6::Shape& s = kQuadShape[q];
             const Tangents t = membrane_k::tangents(x, s);
-            if (!jacobian_ok(t, chord)) {
+            if (!jacobian_ok(t, own)) {
               bad = std::min(bad, e);
               break;
             }
@@ -448,11 +453,11 @@ double ElasticMembrane::compute_energy(std::span<const Vec3> X) const {
 #pragma omp parallel for schedule(static) reduction(min : bad) if (threaded_)
         for (int e = 0; e < E; ++e) {
           const Nodes x = element_nodes(elements_[e], X);
-          const Vec3 chord = chord_normal(x);
+          const Vec3 own = centroid_normal(x);
           double s = 0;
           for (int q = 0; q < tri6::kQuadPoints; ++q) {
             const Tangents t = membrane_k::tangents(x, kQuadShape[q]);
-            if (!jacobian_ok(t, chord)) {
+            if (!jacobian_ok(t, own)) {
               bad = std::min(bad, e);
               break;
             }
@@ -478,10 +483,10 @@ std::vector<NodeStrain> ElasticMembrane::node_strain(std::span<const Vec3> X) co
 #pragma omp parallel for schedule(static) reduction(min : bad) if (threaded_)
   for (int e = 0; e < E; ++e) {
     const Nodes x = element_nodes(elements_[e], X);
-    const Vec3 chord = chord_normal(x);
+    const Vec3 own = centroid_normal(x);
     for (int k = 0; k < 6; ++k) {
       const Tangents t = membrane_k::tangents(x, kNodeShape[k]);
-      if (!jacobian_ok(t, chord)) bad = std::min(bad, e);
+      if (!jacobian_ok(t, own)) bad = std::min(bad, e);
       const RefMetric g = load_metric(ref_node_, 6 * e + k);
       const auto inv = membrane_k::invariants(t, membrane_k::frame(t).J, g);
       en_inv[6 * e + k] = {inv.A1, inv.A2, membrane_k::principal_half_difference(t, g)};
