@@ -80,6 +80,7 @@ def main():
 
     runs = sorted((read_run(d, args.from_kt) for d in args.run_dirs), key=lambda r: r["H"])
     gap = runs[0]["gap_um"]
+    mixed = len({r["resolution"] for r in runs}) > 1  # runs on several grids or meshes: say which in the labels
     fig, (ax, ax_t) = plt.subplots(1, 2, figsize=(12.0, 4.6))
     h = np.linspace(0, 0.45, 91)
     ax.plot(h, pries(h, np.inf), "k-", lw=1, label="Pries et al. (1992), wide tubes")
@@ -89,8 +90,10 @@ def main():
         print(f"{r['dir']}: H = {r['H']:.4f} ({r['cells']} cells, lambda = {r['lambda']:g}, {r['resolution']}): "
               f"eta_rel = {r['mean']:.4f} +- {r['sem']:.4f} over k t = {r['start']:.3g} ... {r['kt'][-1]:.3g}; "
               f"Pries et al. (1992): {wide:.3f} (wide tubes), {narrow:.3f} (D = {r['gap_um']:.3g} um)")
-        ax.errorbar(r["H"], r["mean"], yerr=r["sem"], fmt="o", color=f"C{i}", ms=6, capsize=3)
-        ax_t.plot(r["kt"], r["eta"], "-", color=f"C{i}", lw=1, label=f"H = {r['H']:.2f}")
+        label = f"H = {r['H']:.2f}" + (f", {r['resolution']}" if mixed else "")
+        ax.errorbar(r["H"], r["mean"], yerr=r["sem"], fmt="o", color=f"C{i}", ms=6, capsize=3,
+                    label=r["resolution"] if mixed else None)
+        ax_t.plot(r["kt"], r["eta"], "-", color=f"C{i}", lw=1, label=label)
         ax_t.axvspan(r["start"], r["kt"][-1], color=f"C{i}", alpha=0.05)
         ax_t.hlines(r["mean"], r["start"], r["kt"][-1], colors=f"C{i}", linestyles=":", lw=1.5)
     ax.set_xlabel("hematocrit H (volume fraction of cells)")
@@ -98,8 +101,8 @@ def main():
     ax.set_xlim(0, 0.45)
     ax.set_ylim(bottom=1.0)
     ax.grid(alpha=0.3)
-    ax.legend(fontsize="small", loc="upper left")
-    ax.set_title(f"Mean over the averaging window ({runs[0]['resolution']})", fontsize=10)
+    ax.legend(fontsize="small", loc="lower right" if mixed else "upper left")
+    ax.set_title("Mean over the averaging window" + ("" if mixed else f" ({runs[0]['resolution']})"), fontsize=10)
     ax_t.set_xlabel("dimensionless time k t")
     ax_t.set_ylabel("$\\eta_{rel}$ = wall stress / ($\\mu$ k)")
     ax_t.grid(alpha=0.3)
