@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Installs immerse's build and run dependencies from Debian 12 packages (idempotent).
 set -euo pipefail
-pkgs=(cmake g++ make pkg-config
+pkgs=(cmake g++ make pkg-config lld  # lld: the presets link with it (several times faster than ld)
       libfftw3-dev libfftw3-mpi-dev libhdf5-dev libtomlplusplus-dev libcli11-dev
       petsc-dev openmpi-bin libopenmpi-dev  # MPI: the distributed solver and its tests (mpiexec)
       libgtest-dev libgmock-dev libbenchmark-dev

@@ -494,10 +494,13 @@ TEST(RunMpi, StopSignalToOneProcessStopsAllAfterTheSameStepWithACheckpoint) {
   ScratchDir dir("run_mpi");
   auto args = channel_args(dir / "run", 500);
   const pid_t mpiexec = start_mpi(2, args, dir / "run");
-  // Once a few rows are written, a scheduler's SIGTERM reaches one of the processes.
-  for (int i = 0; i < 600; ++i) {
+  // Once a few rows are written (however long that takes), a scheduler's SIGTERM reaches one of the processes.
+  for (;;) {
     const std::string rows = read_text(dir / "run" / "diagnostics.csv");
     if (std::count(rows.begin(), rows.end(), '\n') >= 4) break;
+    int st = 0;
+    ASSERT_EQ(waitpid(mpiexec, &st, WNOHANG), 0) << "the run ended before its fourth row:\n"
+                                                 << read_text(dir / "run.stderr");
     usleep(100000);
   }
   const auto ranks = children(mpiexec);

@@ -30,9 +30,8 @@ TEST_P(SignalTest, StopsWithStatus4AndACheckpointThatContinuesBitwise) {
   const fs::path file = scenario_file("oscillating_membrane_quick.toml");
   const fs::path out = dir / "interrupted";
   ImmerseProcess p(run_args(file, out, small_membrane_sets(kLongRun)), dir / "interrupted_run");
-  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
   while (rows_written(out / "diagnostics.csv") < 1 + kRowsBeforeSignal) {
-    ASSERT_LT(std::chrono::steady_clock::now(), deadline) << "no diagnostics rows written:\n" << p.err();
+    ASSERT_LT(p.try_wait(), 0) << "the run ended before writing its diagnostics rows:\n" << p.err();
     std::this_thread::sleep_for(std::chrono::milliseconds(20));
   }
   p.signal(GetParam());
@@ -69,11 +68,11 @@ INSTANTIATE_TEST_SUITE_P(Run, SignalTest, ::testing::Values(SIGTERM, SIGINT, SIG
   return p.param == SIGTERM ? "SIGTERM" : p.param == SIGINT ? "SIGINT" : p.param == SIGHUP ? "SIGHUP" : "SIGQUIT";
 });
 
-/// Waits until `csv` holds the header and `rows` rows (or the run ended, or 60 s passed: a failed expectation).
+/// Waits until `csv` holds the header and `rows` rows, however long that takes (a run that ends before: a failed
+/// expectation).
 void wait_for_rows(ImmerseProcess& p, const fs::path& csv, std::size_t rows) {
-  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
   while (rows_written(csv) < 1 + rows) {
-    ASSERT_LT(std::chrono::steady_clock::now(), deadline) << "no diagnostics rows written:\n" << p.err();
+    ASSERT_LT(p.try_wait(), 0) << "the run ended before writing its diagnostics rows:\n" << p.err();
     std::this_thread::sleep_for(std::chrono::milliseconds(20));
   }
 }
@@ -89,7 +88,7 @@ TEST(SignalStorm, RepeatedSigtermStillEndsWithStatus4AndAValidCheckpoint) {
                    dir / "run");
   wait_for_rows(p, out / "diagnostics.csv", kRowsBeforeSignal);
   int status = -1;
-  for (int i = 0; i < 20000 && status < 0; ++i) {
+  while (status < 0) {  // until the program ends
     p.signal(SIGTERM);
     std::this_thread::sleep_for(std::chrono::milliseconds(2));
     status = p.try_wait();
@@ -108,9 +107,8 @@ TEST(SignalHalving, StopRequestIsHonouredBetweenAttemptsOfAHalvedStep) {
   auto sets = small_membrane_sets(8);
   sets.insert(sets.end(), {"solver.max_newton_its=1", "solver.newton_rtol=1e-300", "time.dt_min=1e-300"});
   ImmerseProcess p(run_args(scenario_file("oscillating_membrane_quick.toml"), out, sets), dir / "run");
-  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
   while (p.out().find("step 1, t = 0: step rejected with dt = ") == std::string::npos) {
-    ASSERT_LT(std::chrono::steady_clock::now(), deadline) << "no rejected step:\n" << p.out() << p.err();
+    ASSERT_LT(p.try_wait(), 0) << "the run ended without a rejected step:\n" << p.out() << p.err();
     std::this_thread::sleep_for(std::chrono::milliseconds(20));
   }
   p.signal(SIGTERM);

@@ -29,7 +29,7 @@ std::vector<Vec3> read(const double* in, int n) {
 
 /// out[r] sent to process r; returns what every process sent to this one, in rank order (one MPI_Alltoall of the
 /// counts, one MPI_Alltoallv). Collective.
-std::vector<double> exchange(const Communicator& comm, const std::vector<std::vector<double>>& out) {
+std::vector<double> all_to_all(const Communicator& comm, const std::vector<std::vector<double>>& out) {
   const int size = comm.size();
   std::vector<int> send_counts(size), send_offsets(size, 0), recv_counts(size), recv_offsets(size, 0);
   for (int r = 0; r < size; ++r) send_counts[r] = static_cast<int>(out[r].size());
@@ -129,7 +129,7 @@ int MembraneOwnership::migrate() {
   const int leaving = static_cast<int>(owned_.size() - staying.size());
   owned_ = std::move(staying);
 
-  const std::vector<double> recv = exchange(comm, out);
+  const std::vector<double> recv = all_to_all(comm, out);
   for (std::size_t at = 0; at < recv.size();) {
     const int id = static_cast<int>(recv[at]);
     const int n = node_counts_.at(static_cast<std::size_t>(id));
@@ -170,7 +170,7 @@ std::vector<double> MembraneOwnership::follow(std::span<const double> before, st
     }
     at += n;
   }
-  const std::vector<double> recv = exchange(comm, out);
+  const std::vector<double> recv = all_to_all(comm, out);
   for (std::size_t q = 0; q < recv.size();) {
     const auto id = static_cast<std::size_t>(recv[q]);
     const std::size_t n = 3 * static_cast<std::size_t>(node_counts_.at(id));
