@@ -97,12 +97,12 @@ Nodes element_nodes(const std::array<int, 6>& el, std::span<const Vec3> X) {
   return s > 0 && std::isfinite(s);
 }
 
-/// a_xi x a_eta at the centroid: N_k derivatives at xi = eta = 1/3 are (-1/3, 1/3, 0, 0, 4/3, -4/3) along xi and
-/// (-1/3, 0, 1/3, -4/3, 4/3, 0) along eta.
+constexpr tri6::Shape kCentroidShape = tri6::shape(1.0 / 3, 1.0 / 3);
+
+/// a_xi x a_eta at the element's centroid.
 [[gnu::always_inline]] inline Vec3 centroid_normal(const Nodes& x) {
-  const Vec3 a_xi = (x[1] - x[0]) * (1.0 / 3) + (x[4] - x[5]) * (4.0 / 3);
-  const Vec3 a_eta = (x[2] - x[0]) * (1.0 / 3) + (x[4] - x[3]) * (4.0 / 3);
-  return cross(a_xi, a_eta);
+  const Tangents t = membrane_k::tangents(x, kCentroidShape);
+  return cross(t.a_xi, t.a_eta);
 }
 
 /// The Jacobian signed against the centroid normal at the six element nodes, where a curved element folds first (a
