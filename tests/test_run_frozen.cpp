@@ -25,6 +25,8 @@ struct Case {
   int threads;
 };
 
+void PrintTo(const Case& c, std::ostream* os) { *os << c.name; }
+
 std::vector<Case> cases() {
   auto capsule = small_membrane_sets(4);
   capsule.insert(capsule.end(), {"grid.nx=44", "grid.ny=44", "grid.nz=44", "membrane[0].mesh.level=2",

@@ -1,4 +1,4 @@
-// `immerse run` under mpiexec (DistributedRun): the quick red-cell channel with midpoint RK2 written on 2 processes,
+// `immerse run` under mpiexec: the quick red-cell channel with midpoint RK2 written on 2 processes,
 // continued on 3 and in one process, against the uninterrupted one-process run, and the same with Anderson, λ = 5
 // cells and the volume correction; repeated runs bitwise; bad input on 3 processes; the ParaView frames written
 // together by the processes.

@@ -9,7 +9,7 @@ class ChannelRun : public CellScenarioRun {
   ChannelRun() : CellScenarioRun(1) {}
 
   std::vector<Column> run_columns() const override;
-  void add_run_values(const Simulation& sim, std::vector<double>& row) const override;
+  void add_run_values(const SimulationInterface& sim, std::vector<double>& row) const override;
 };
 
 }  // namespace immerse

@@ -112,7 +112,7 @@ double inclination(const MembraneGeometry& g) {
   return t;
 }
 
-std::vector<double> Diagnostics::row(const Simulation& sim, const StepRecord& r) const {
+std::vector<double> Diagnostics::row(const SimulationInterface& sim, const StepRecord& r) const {
   std::vector<double> row{double(r.step), r.time};
   if (shear_rate_ > 0) row.push_back(shear_rate_ * r.time);
   row.insert(row.end(), {r.dt,
@@ -121,8 +121,9 @@ std::vector<double> Diagnostics::row(const Simulation& sim, const StepRecord& r)
                           double(r.stats.fluid_solves),
                           r.stats.residual,
                           r.wall_seconds});
+  const std::vector<std::vector<Vec3>> positions = sim.positions();
   for (std::size_t m = 0; m < sim.num_membranes(); ++m) {
-    const auto X = sim.op().membrane_positions(m);
+    const std::vector<Vec3>& X = positions[m];
     const MembraneGeometry g = measure(sim.mesh(m), X);
     const ShearPlaneProfile p = shear_plane_profile(sim.mesh(m), X, g.centroid);
     const auto a = semi_axes_along_xyz(g);
@@ -132,9 +133,7 @@ std::vector<double> Diagnostics::row(const Simulation& sim, const StepRecord& r)
     scenario_.add_membrane_values(X, row);
   }
   scenario_.add_run_values(sim, row);
-  std::vector<MembraneEnergy> energies;
-  for (std::size_t m = 0; m < sim.num_membranes(); ++m) energies.push_back(sim.membrane_energy(m));
-  add_energy_values(sim.energy_budget(), energies, row);
+  add_energy_values(sim.energy_budget(), sim.membrane_energies(), row);
   return row;
 }
 

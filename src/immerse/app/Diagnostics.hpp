@@ -2,8 +2,8 @@
 // The per-step diagnostics of a run: the rows of diagnostics.csv (step, time, solver counts, then per membrane its
 // volume, area, centroid, semi-axes, Taylor deformation D_xz and inclination, then the scenario's own columns, then
 // the energy budget: the fluid's kinetic energy, dissipation and powers, each membrane's energies, the total energy
-// and the budget's residual, docs/energy-budget.md). Shared by `immerse run`, its distributed run and the Python
-// module.
+// and the budget's residual, docs/energy-budget.md). Shared by `immerse run` (in one process or many) and the
+// Python module.
 #include <array>
 #include <filesystem>
 #include <span>
@@ -14,7 +14,7 @@
 #include "immerse/app/ScenarioRun.hpp"
 #include "immerse/io/Config.hpp"
 #include "immerse/membrane/Geometry.hpp"
-#include "immerse/simulation/Simulation.hpp"
+#include "immerse/simulation/SimulationInterface.hpp"
 
 namespace immerse {
 
@@ -25,8 +25,8 @@ class Diagnostics {
   Diagnostics(const io::Config& config, std::size_t membranes, const ScenarioRun& scenario);
 
   const std::vector<Column>& columns() const { return columns_; }
-  /// The row after the step r (the membranes' committed state).
-  std::vector<double> row(const Simulation& sim, const StepRecord& r) const;
+  /// The row after the step r (the membranes' committed state), on every process. Collective.
+  std::vector<double> row(const SimulationInterface& sim, const StepRecord& r) const;
 
  private:
   const ScenarioRun& scenario_;

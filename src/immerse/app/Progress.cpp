@@ -9,15 +9,16 @@
 #include <sstream>
 #include <string>
 
-#include "immerse/simulation/Simulation.hpp"
+#include "immerse/simulation/SimulationInterface.hpp"
 
 namespace immerse {
 
 Progress::Progress(std::ostream& out, double end, double log_seconds)
     : out_(out), end_(end), every_(log_seconds), tty_(isatty(STDOUT_FILENO)), t0_(clock::now()), last_(t0_) {}
 
-void Progress::update(const Simulation& sim, long steps_done) {
-  update(sim.time(), sim.step(), [&sim] { return sim.op().min_wall_distance(); }, steps_done);
+void Progress::update(const SimulationInterface& sim, long steps_done) {
+  const double wall = sim.min_wall_distance();  // on every process, at every step: a collective call
+  update(sim.time(), sim.step(), [wall] { return wall; }, steps_done);
 }
 
 void Progress::update(double time, long step, const std::function<double()>& wall_distance, long steps_done) {

@@ -7,12 +7,13 @@
 
 namespace immerse {
 
-class Simulation;
+class SimulationInterface;
 
 class Progress {
  public:
   Progress(std::ostream& out, double end, double log_seconds);
-  void update(const Simulation& sim, long steps_done);
+  /// Collective (the closest approach to a wall).
+  void update(const SimulationInterface& sim, long steps_done);
   /// The same for a run at `time` and `step`; `wall_distance` gives the closest approach of a node to a wall (not
   /// shown if not finite), asked only when a line is due.
   void update(double time, long step, const std::function<double()>& wall_distance, long steps_done);

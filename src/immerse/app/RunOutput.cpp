@@ -8,6 +8,7 @@
 #include "immerse/core/Error.hpp"
 #include "immerse/io/AtomicFile.hpp"
 #include "immerse/io/TomlFormat.hpp"
+#include "immerse/parallel/Agreement.hpp"
 
 namespace immerse {
 
@@ -68,39 +69,16 @@ std::vector<std::string> derived_values(const io::Config& config) {
   return lines;
 }
 
-void write_frame(io::XdmfWriter& writer, const Simulation& sim, bool fluid_fields) {
-  std::vector<std::vector<Vec3>> X, U, F;
-  std::vector<std::vector<double>> tau1, tau2;
-  std::vector<io::SurfaceFrame> frames;
-  for (std::size_t m = 0; m < sim.num_membranes(); ++m) {
-    X.push_back(sim.op().membrane_positions(m));
-    U.push_back(sim.op().membrane_velocities(m));
-    F.emplace_back();
-    sim.membrane(m).compute_force(X.back(), F.back());
-    const auto strain = sim.membrane(m).node_strain(X.back());
-    tau1.emplace_back();
-    tau2.emplace_back();
-    for (const auto& s : strain) tau1.back().push_back(s.tau1), tau2.back().push_back(s.tau2);
-  }
-  for (std::size_t m = 0; m < sim.num_membranes(); ++m)
-    frames.push_back({"membrane" + std::to_string(m),
-                      X[m],
-                      sim.mesh(m).elements,
-                      {{"force", F[m]}, {"velocity", U[m]}},
-                      {{"tension_1", tau1[m]}, {"tension_2", tau2[m]}}});
-  const auto& f = sim.op().fluid_state();
-  const io::FluidFrame fluid{sim.grid(), f.u, f.p};
-  writer.write_frame(sim.time(), frames, fluid_fields ? &fluid : nullptr);
-}
-
 }  // namespace
 
 // A restart in place continues the tables after the checkpoint (a damaged table is refused before anything is
 // rewritten) and the frame series after the checkpoint's frame.
-RunOutput::RunOutput(const RunOptions& options, const Simulation& sim, const RunSettings& settings,
+RunOutput::RunOutput(const RunOptions& options, const SimulationInterface& sim, const RunSettings& settings,
                      ScenarioRun& scenario)
     : options_(options),
       sim_(sim),
+      comm_(sim.communicator()),
+      root_(comm_.rank() == 0),
       settings_(settings),
       scenario_(scenario),
       dir_(options.out),
@@ -108,13 +86,17 @@ RunOutput::RunOutput(const RunOptions& options, const Simulation& sim, const Run
       in_place_(continues_in_place(options)),
       first_frame_(in_place_ && settings.fields_every > 0 ? static_cast<int>(sim.step() / settings.fields_every) + 1
                                                           : 0),
-      folder_(dir_),
+      frame_(first_frame_),
       diagnostics_(sim.config(), sim.num_membranes(), scenario),
       diagnostics_table_("diagnostics", diagnostics_.columns(),
                          [this](long, double step) { return step <= double(sim_.step()); }),
       start_step_(sim.step()),
       start_time_(sim.time()) {
-  if (const auto found = folder_.run_files(); !found.empty() && !in_place_ && !options.overwrite) {
+  tables_.push_back(&diagnostics_table_);
+  for (OutputTable* t : scenario.tables()) tables_.push_back(t);
+  if (!root_) return;
+  folder_.emplace(dir_);
+  if (const auto found = folder_->run_files(); !found.empty() && !in_place_ && !options.overwrite) {
     std::string names;
     for (std::size_t i = 0; i < std::min<std::size_t>(found.size(), 3); ++i) names += (i ? ", " : "") + found[i];
     if (found.size() > 3) names += ", ...";
@@ -123,8 +105,6 @@ RunOutput::RunOutput(const RunOptions& options, const Simulation& sim, const Run
                                  : "continue it with --restart " + checkpoint_file().string()) +
                      ", or replace it with --overwrite");
   }
-  tables_.push_back(&diagnostics_table_);
-  for (OutputTable* t : scenario.tables()) tables_.push_back(t);
   if (in_place_)
     for (OutputTable* t : tables_) t->read_kept_rows(dir_);
 }
@@ -132,28 +112,45 @@ RunOutput::RunOutput(const RunOptions& options, const Simulation& sim, const Run
 void RunOutput::create(const MeshCopies& copies, std::ostream& out) {
   provenance_ = io::Provenance::now(
       options_.command_line.empty() ? "immerse run " + options_.file.string() : options_.command_line,
-      sim_.op().thread_governor().policy());
+      sim_.thread_policy());
   if (restarted_)
     provenance_.restarted_from = options_.restart.string() + " at step " + std::to_string(sim_.step()) + ", t = " +
                                  io::format_number(sim_.time()) + (in_place_ ? " (continued)" : " (branched)");
-  folder_.keep_run_files();  // until the first files are written: a failure leaves the folder as it was
-  try {
-    frames_.emplace(dir_, first_frame_);  // a restart reads back the frames before the checkpoint first
-    frames_->set_attributes(provenance_.attributes());
-    if (options_.overwrite) folder_.remove_run_files();
-    folder_.remove_temporaries();  // of a writer that was killed
-    for (const OutputTable* t : tables_) t->write_kept_rows(dir_);
-    print_header(copies, out);
-    io::AtomicFile::write(dir_ / "config.resolved.toml", provenance_.toml_comments() + copies.config.to_toml_string());
-    for (const auto& [name, content] : copies.files) io::AtomicFile::write(dir_ / name, content);
-    for (const OutputTable* t : tables_) t->write_column_table(dir_);
-    const auto mode = in_place_ ? io::CsvWriter::Mode::Append : io::CsvWriter::Mode::Create;
-    for (OutputTable* t : tables_) t->open(dir_, mode);
-  } catch (const WriteError&) {
-    folder_.restore_kept();
-    throw;
-  }
-  folder_.drop_kept();
+  // Rank 0's host and start time on every process: attributes that the processes write together must be equal.
+  for (std::string* s : {&provenance_.version, &provenance_.commit, &provenance_.command_line, &provenance_.start_time,
+                         &provenance_.host, &provenance_.threads, &provenance_.restarted_from})
+    *s = broadcast_text(comm_, *s);
+  on_root([&] {
+    folder_->keep_run_files();  // until the first files are written: a failure leaves the folder as it was
+    try {
+      frames_.emplace(dir_, first_frame_);  // a restart reads back the frames before the checkpoint first
+      frames_->set_attributes(provenance_.attributes());
+      if (options_.overwrite) folder_->remove_run_files();
+      folder_->remove_temporaries();  // of a writer that was killed
+      for (const OutputTable* t : tables_) t->write_kept_rows(dir_);
+      print_header(copies, out);
+      io::AtomicFile::write(dir_ / "config.resolved.toml",
+                            provenance_.toml_comments() + copies.config.to_toml_string());
+      for (const auto& [name, content] : copies.files) io::AtomicFile::write(dir_ / name, content);
+      for (const OutputTable* t : tables_) t->write_column_table(dir_);
+      const auto mode = in_place_ ? io::CsvWriter::Mode::Append : io::CsvWriter::Mode::Create;
+      for (OutputTable* t : tables_) t->open(dir_, mode);
+    } catch (const WriteError&) {
+      folder_->restore_kept();
+      throw;
+    }
+    folder_->drop_kept();
+  });
+}
+
+void RunOutput::on_root(const std::function<void()>& work) const {
+  std::string failed;
+  if (root_) try {
+      work();
+    } catch (const WriteError& e) {
+      failed = e.what();
+    }
+  if (const std::string first = first_error(comm_, failed); !first.empty()) throw WriteError(first);
 }
 
 void RunOutput::print_header(const MeshCopies& copies, std::ostream& out) const {
@@ -161,6 +158,7 @@ void RunOutput::print_header(const MeshCopies& copies, std::ostream& out) const 
       << " -> " << dir_.string() << "\n";
   for (const auto& line : derived_values(copies.config)) out << "# derived: " << line << "\n";
   if (!sim_.packing_summary().empty()) out << "# " << sim_.packing_summary() << "\n";
+  if (const std::string d = sim_.decomposition_summary(); !d.empty()) out << "# " << d << "\n";
   if (options_.verbose)
     out << "# resolved configuration (saved as config.resolved.toml)\n" << copies.config.to_toml_string();
   out << std::flush;
@@ -176,35 +174,40 @@ std::vector<Callback> RunOutput::callbacks(const StepRecord& last) {
 
 // A row needs the record of its step: the step that turned out unstable has none.
 Callback RunOutput::diagnostics_callback(const StepRecord& last) {
-  return {"diagnostics", settings_.diagnostics_every, !in_place_, true, [this, &last](const Simulation& s) {
-            if (last.step == s.step()) diagnostics_table_.row(diagnostics_.row(s, last));
+  return {"diagnostics", settings_.diagnostics_every, !in_place_, true, [this, &last](const SimulationInterface& s) {
+            if (last.step != s.step()) return;
+            const std::vector<double> row = diagnostics_.row(s, last);
+            on_root([&] { diagnostics_table_.row(row); });
           }};
 }
 
 Callback RunOutput::fields_callback() {
   const bool on = settings_.fields_every > 0;
   return {"fields", settings_.fields_every, !in_place_ && on, on,
-          [this](const Simulation& s) { write_frame(*frames_, s, settings_.fluid_fields); }};
+          [this](const SimulationInterface& s) {
+            s.write_frame(root_ ? &*frames_ : nullptr, dir_, frame_, provenance_.attributes(), settings_.fluid_fields);
+            ++frame_;
+          }};
 }
 
 // A checkpoint is newer than the unstable state of an attempt this run continues: that post-mortem file goes.
 Callback RunOutput::checkpoint_callback() {
-  return {"checkpoint", settings_.checkpoint_every, false, true, [this](const Simulation& s) {
-            io::Checkpoint ck = s.checkpoint();
-            scenario_.save(ck);
-            ck.set_attributes(provenance_.attributes());
+  return {"checkpoint", settings_.checkpoint_every, false, true, [this](const SimulationInterface& s) {
+            const auto scenario_state = [this](io::Checkpoint& ck) { scenario_.save(ck); };
             if (unstable_) {
-              ck.write(unstable_state_file(dir_));
+              s.write_checkpoint(unstable_state_file(dir_), provenance_.attributes(), scenario_state);
               unstable_written_ = true;
               return;
             }
-            ck.write(checkpoint_file());
+            s.write_checkpoint(checkpoint_file(), provenance_.attributes(), scenario_state);
             checkpoint_step_ = s.step();
             checkpoint_time_ = s.time();
             if (!stale_unstable_removed_) {
-              std::error_code ec;
-              std::filesystem::remove(unstable_state_file(dir_), ec);
-              if (ec) throw WriteError("cannot remove " + unstable_state_file(dir_).string() + ": " + ec.message());
+              on_root([&] {
+                std::error_code ec;
+                std::filesystem::remove(unstable_state_file(dir_), ec);
+                if (ec) throw WriteError("cannot remove " + unstable_state_file(dir_).string() + ": " + ec.message());
+              });
               stale_unstable_removed_ = true;
             }
           }};
@@ -216,11 +219,11 @@ std::string RunOutput::unstable_stop_line() const {
     kept = {checkpoint_file(), checkpoint_step_, checkpoint_time_, true};
   else if (restarted_)
     kept = {options_.restart, start_step_, start_time_, in_place_};
-  return immerse::unstable_stop_line(options_, sim_.config(), kept, sim_.step(), unstable_written_);
+  return immerse::unstable_stop_line(options_, sim_.config(), kept, sim_.step(), unstable_written_, comm_.size());
 }
 
 void RunOutput::discard() const {
-  if (!in_place_) folder_.remove_run_files();
+  if (root_ && !in_place_) folder_->remove_run_files();
 }
 
 }  // namespace immerse

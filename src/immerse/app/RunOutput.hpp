@@ -2,7 +2,13 @@
 // The output of `immerse run`: its folder (locked; another run's is refused unless continued or replaced), the first
 // files, and the callbacks that write diagnostics rows, ParaView frames and checkpoints on their schedules. A restart
 // into another folder branches the run: a new series that begins at the checkpoint's step.
+//
+// In a run over several MPI processes rank 0 alone takes the folder and writes the tables, the resolved configuration,
+// the copies of mesh files and the XDMF series; frames and checkpoints are written by all processes together
+// (SimulationInterface). A write that fails on rank 0 fails on every process (WriteError). Construction is local;
+// create() and the callbacks are collective.
 #include <filesystem>
+#include <functional>
 #include <iosfwd>
 #include <optional>
 #include <string>
@@ -18,20 +24,22 @@
 #include "immerse/io/OutputFolder.hpp"
 #include "immerse/io/Provenance.hpp"
 #include "immerse/io/XdmfWriter.hpp"
-#include "immerse/simulation/Simulation.hpp"
+#include "immerse/simulation/SimulationInterface.hpp"
 
 namespace immerse {
 
 class RunOutput {
  public:
   /// Checks the folder and, when the run continues in it, reads the rows of its tables to keep (InputError on a
-  /// folder the run may not take or a damaged table). Writes nothing.
-  RunOutput(const RunOptions& options, const Simulation& sim, const RunSettings& settings, ScenarioRun& scenario);
+  /// folder the run may not take or a damaged table; on rank 0 only, whose error the caller shares). Writes nothing.
+  RunOutput(const RunOptions& options, const SimulationInterface& sim, const RunSettings& settings,
+            ScenarioRun& scenario);
   RunOutput(const RunOutput&) = delete;
   RunOutput& operator=(const RunOutput&) = delete;
 
   /// Writes the first files, opens the tables and the frame series, and prints the run's header on `out`. If a
-  /// file cannot be written, a folder this run created is removed again and an existing one is put back as it was.
+  /// file cannot be written, a folder this run created is removed again and an existing one is put back as it was
+  /// (WriteError on every process). Collective.
   void create(const MeshCopies& copies, std::ostream& out);
 
   /// The output callbacks; `last` is the record of the last accepted step, which a diagnostics row reports.
@@ -54,15 +62,19 @@ class RunOutput {
   Callback fields_callback();
   Callback checkpoint_callback();
   void print_header(const MeshCopies& copies, std::ostream& out) const;
+  /// Runs `work` on rank 0 (nothing elsewhere); its WriteError is thrown on every process. Collective.
+  void on_root(const std::function<void()>& work) const;
 
   const RunOptions& options_;
-  const Simulation& sim_;
+  const SimulationInterface& sim_;
+  const Communicator& comm_;
+  bool root_;
   const RunSettings& settings_;
   ScenarioRun& scenario_;
   std::filesystem::path dir_;
   bool restarted_, in_place_;
-  int first_frame_ = 0;
-  io::OutputFolder folder_;
+  int first_frame_ = 0, frame_ = 0;
+  std::optional<io::OutputFolder> folder_;  ///< on rank 0
   Diagnostics diagnostics_;
   OutputTable diagnostics_table_;
   std::vector<OutputTable*> tables_;  ///< diagnostics.csv first, then the scenario's

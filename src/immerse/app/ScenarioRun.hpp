@@ -17,7 +17,7 @@
 namespace immerse {
 
 class OutputTable;
-class Simulation;
+class SimulationInterface;
 
 class ScenarioRun {
  public:
@@ -31,19 +31,19 @@ class ScenarioRun {
   virtual std::vector<Column> run_columns() const { return {}; }
   /// Appends the values of membrane_columns() for a membrane at positions X, and those of run_columns().
   virtual void add_membrane_values(const std::vector<Vec3>& /*X*/, std::vector<double>& /*row*/) const {}
-  virtual void add_run_values(const Simulation& /*sim*/, std::vector<double>& /*row*/) const {}
+  virtual void add_run_values(const SimulationInterface& /*sim*/, std::vector<double>& /*row*/) const {}
 
   /// Binds the scenario to the built simulation, before a restart restores it (InputError on input it cannot run).
-  virtual void attach(Simulation& /*sim*/) {}
+  virtual void attach(SimulationInterface& /*sim*/) {}
   /// Starts the scenario's own state at the start of a run, or continues it from a checkpoint written by save().
-  virtual void start(Simulation& /*sim*/) {}
-  virtual void restore(const io::Checkpoint& /*ck*/, Simulation& /*sim*/) {}
+  virtual void start(SimulationInterface& /*sim*/) {}
+  virtual void restore(const io::Checkpoint& /*ck*/, SimulationInterface& /*sim*/) {}
   virtual void save(io::Checkpoint& /*ck*/) const {}
 
   /// The tables it writes besides diagnostics.csv.
   virtual std::vector<OutputTable*> tables() { return {}; }
   /// Runs after each accepted step, before the step's callbacks, so that a checkpoint of the step holds its effect.
-  virtual void after_step(Simulation& /*sim*/, const std::function<void(const std::string&)>& /*log*/,
+  virtual void after_step(SimulationInterface& /*sim*/, const std::function<void(const std::string&)>& /*log*/,
                           std::ostream& /*out*/) {}
   /// True once the scenario has nothing left to do: the run ends before time.end.
   virtual bool done() const { return false; }

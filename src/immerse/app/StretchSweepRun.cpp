@@ -2,6 +2,7 @@
 
 #include <ostream>
 
+#include "immerse/core/Error.hpp"
 #include "immerse/membrane/CellDiameters.hpp"
 #include "immerse/simulation/Simulation.hpp"
 
@@ -17,8 +18,17 @@ StretchSweepRun::StretchSweepRun()
              [this](long row, double) { return row < long(sweep_->current()); }) {}
 
 // A force that has waited scenario.max_relaxation_times without a steady state is recorded anyway.
-void StretchSweepRun::after_step(Simulation& sim, const std::function<void(const std::string&)>& log,
+void StretchSweepRun::attach(SimulationInterface& sim) {
+  sim_ = dynamic_cast<Simulation*>(&sim);
+  if (!sim_)
+    throw InputError("scenario.kind = \"rbc_stretch\": its forces on the contact patches are not distributed over " +
+                     std::to_string(sim.communicator().size()) + " MPI processes (run it in one process)");
+  sweep_.emplace(*sim_);
+}
+
+void StretchSweepRun::after_step(SimulationInterface&, const std::function<void(const std::string&)>& log,
                                  std::ostream& out) {
+  Simulation& sim = *sim_;
   const bool steady = sweep_->steady(sim);
   if (!steady && !sweep_->timed_out(sim)) return;
   const double F = sweep_->forces()[sweep_->current()];

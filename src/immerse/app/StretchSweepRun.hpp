@@ -13,18 +13,20 @@ class StretchSweepRun : public CellScenarioRun {
  public:
   StretchSweepRun();
 
-  void attach(Simulation& sim) override { sweep_.emplace(sim); }
-  void start(Simulation& sim) override { sweep_->start(sim, 0); }
-  void restore(const io::Checkpoint& ck, Simulation& sim) override { sweep_->restore(ck, sim); }
+  /// InputError unless `sim` runs in one process (the applied forces are not distributed).
+  void attach(SimulationInterface& sim) override;
+  void start(SimulationInterface&) override { sweep_->start(*sim_, 0); }
+  void restore(const io::Checkpoint& ck, SimulationInterface&) override { sweep_->restore(ck, *sim_); }
   void save(io::Checkpoint& ck) const override { sweep_->save(ck); }
 
   std::vector<OutputTable*> tables() override { return {&table_}; }
-  void after_step(Simulation& sim, const std::function<void(const std::string&)>& log, std::ostream& out) override;
+  void after_step(SimulationInterface& sim, const std::function<void(const std::string&)>& log, std::ostream& out) override;
   bool done() const override { return sweep_->done(); }
   void announce(std::ostream& out) const override;
   void report_unfinished(std::ostream& out, const std::filesystem::path& checkpoint) const override;
 
  private:
+  Simulation* sim_ = nullptr;          ///< from attach() on
   std::optional<StretchSweep> sweep_;  ///< from attach() on
   OutputTable table_;                  ///< stretch.csv: one row per force
 };

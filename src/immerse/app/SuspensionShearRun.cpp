@@ -1,9 +1,8 @@
 #include "immerse/app/SuspensionShearRun.hpp"
 
 #include "immerse/app/Scenario.hpp"
-#include "immerse/fluid/FluidDiagnostics.hpp"
 #include "immerse/membrane/Geometry.hpp"
-#include "immerse/simulation/Simulation.hpp"
+#include "immerse/simulation/SimulationInterface.hpp"
 
 namespace immerse {
 
@@ -22,20 +21,13 @@ std::vector<Column> SuspensionShearRun::run_columns() const {
                                       "suspending fluid's"}};
 }
 
-void SuspensionShearRun::add_run_values(const Simulation& sim, std::vector<double>& row) const {
+void SuspensionShearRun::add_run_values(const SimulationInterface& sim, std::vector<double>& row) const {
   double volume = 0;
-  for (std::size_t m = 0; m < sim.num_membranes(); ++m)
-    volume += measure(sim.mesh(m), sim.op().membrane_positions(m)).volume;
-  const auto& u = sim.op().fluid_state().u;
-  const Array3* chi = &sim.op().viscosity_indicator();
-  const double lower = wall_shear_stress(sim.grid(), u, chi, mu_, false, lower_x_);
-  const double upper = wall_shear_stress(sim.grid(), u, chi, mu_, true, upper_x_);
-  add_values(volume, lower, upper, row);
-}
-
-void SuspensionShearRun::add_values(double enclosed_volume, double lower, double upper,
-                                    std::vector<double>& row) const {
-  row.insert(row.end(), {enclosed_volume / box_volume_, lower, upper, 0.5 * (lower + upper) / (mu_ * shear_rate_)});
+  const auto X = sim.positions();
+  for (std::size_t m = 0; m < X.size(); ++m) volume += measure(sim.mesh(m), X[m]).volume;
+  const double lower = sim.wall_shear_stress(false, mu_, lower_x_);
+  const double upper = sim.wall_shear_stress(true, mu_, upper_x_);
+  row.insert(row.end(), {volume / box_volume_, lower, upper, 0.5 * (lower + upper) / (mu_ * shear_rate_)});
 }
 
 }  // namespace immerse

@@ -19,13 +19,7 @@ class SuspensionShearRun : public ScenarioRun {
   explicit SuspensionShearRun(const io::Config& config);
 
   std::vector<Column> run_columns() const override;
-  void add_run_values(const Simulation& sim, std::vector<double>& row) const override;
-  /// The run values from the volume all membranes enclose and the two wall stresses (shared with the distributed
-  /// run, which reduces them over its processes).
-  void add_values(double enclosed_volume, double lower, double upper, std::vector<double>& row) const;
-  double viscosity() const { return mu_; }
-  double lower_wall_velocity() const { return lower_x_; }
-  double upper_wall_velocity() const { return upper_x_; }
+  void add_run_values(const SimulationInterface& sim, std::vector<double>& row) const override;
 
  private:
   double mu_, shear_rate_, box_volume_;

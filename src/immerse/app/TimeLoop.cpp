@@ -4,13 +4,14 @@
 #include <ostream>
 
 #include "immerse/app/StopSignals.hpp"
+#include "immerse/parallel/Agreement.hpp"
 
 namespace immerse {
 
 namespace {
 
 // The record the first row of a series reports: the initial state, or the checkpoint's step after a restart.
-StepRecord record_of_start(const Simulation& sim) {
+StepRecord record_of_start(const SimulationInterface& sim) {
   StepRecord r;
   r.step = sim.step();
   r.time = sim.time();
@@ -19,7 +20,7 @@ StepRecord record_of_start(const Simulation& sim) {
 
 }  // namespace
 
-TimeLoop::TimeLoop(Simulation& sim, ScenarioRun& scenario, RunOutput& output, const RunSettings& settings,
+TimeLoop::TimeLoop(SimulationInterface& sim, ScenarioRun& scenario, RunOutput& output, const RunSettings& settings,
                    std::ostream& out, std::ostream& err)
     : sim_(sim),
       scenario_(scenario),
@@ -29,13 +30,18 @@ TimeLoop::TimeLoop(Simulation& sim, ScenarioRun& scenario, RunOutput& output, co
       last_(record_of_start(sim)),
       callbacks_(output.callbacks(last_)),
       progress_(out, settings.end_time, settings.log_seconds),
-      timings_at_start_(sim.op().timings()) {}
+      timings_at_start_(sim.timings()) {}
+
+bool TimeLoop::stop_signal() {
+  signal_ = max_over_processes(sim_.communicator(), StopSignals::received());
+  return signal_ != 0;
+}
 
 int TimeLoop::run() {
   try {
     for (auto& c : callbacks_)
       if (c.at_start) c.run(sim_, sim_.step());
-    if (StopSignals::received()) status_ = 4;
+    if (stop_signal()) status_ = 4;
     while (status_ == 0 && !sim_.finished() && !scenario_.done()) step_once();
     if (status_ == 0) scenario_.report_unfinished(out_, output_.checkpoint_file());
   } catch (const SimulationError& e) {
@@ -45,6 +51,7 @@ int TimeLoop::run() {
     output_.stop_unstable();
   } catch (const StopRequested&) {
     status_ = 4;  // while a rejected step was to be retried: the state is the last accepted step's
+    stop_signal();
   } catch (const WriteError& e) {
     write_failed(e);
   } catch (const InputError&) {
@@ -74,7 +81,7 @@ int TimeLoop::run() {
     }
   if (status_ == 3) err_ << output_.unstable_stop_line();
   if (status_ == 4)
-    err_ << "immerse: interrupted by signal " << StopSignals::received() << " at step " << sim_.step() << ", t = "
+    err_ << "immerse: interrupted by signal " << signal_ << " at step " << sim_.step() << ", t = "
          << sim_.time() << "; checkpoint written to " << output_.checkpoint_file().string() << "\n";
   return status_;
 }
@@ -98,7 +105,7 @@ void TimeLoop::step_once() {
   for (auto& c : callbacks_)
     if (c.due(sim_.step())) c.run(sim_, sim_.step());
   progress_.update(sim_, steps_);
-  if (StopSignals::received()) status_ = 4;
+  if (stop_signal()) status_ = 4;
 }
 
 void TimeLoop::log(const std::string& message) { out_ << "\n" << message << "\n" << std::flush; }

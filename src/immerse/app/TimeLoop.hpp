@@ -1,6 +1,7 @@
 #pragma once
-// The time loop of `immerse run`: steps until time.end, the scenario's end or a stop signal, with the scenario's work
-// and the output callbacks after each step, and turns what ended the run into its exit status. The last state is
+// The time loop of `immerse run`, in one process or many: steps until time.end, the scenario's end or a stop signal
+// (received by any process: the processes agree after each step), with the scenario's work and the output callbacks
+// after each step, and turns what ended the run into its exit status. The last state is
 // always saved, unless writing is what failed: after an instability to unstable_state.h5, for inspection, leaving
 // checkpoint.h5 at the last good step (UnstableStop.hpp).
 #include <iosfwd>
@@ -13,14 +14,15 @@
 #include "immerse/app/RunSettings.hpp"
 #include "immerse/app/ScenarioRun.hpp"
 #include "immerse/core/Error.hpp"
-#include "immerse/simulation/Simulation.hpp"
+#include "immerse/simulation/SimulationInterface.hpp"
 #include "immerse/simulation/StepTimings.hpp"
 
 namespace immerse {
 
 class TimeLoop {
  public:
-  TimeLoop(Simulation& sim, ScenarioRun& scenario, RunOutput& output, const RunSettings& settings, std::ostream& out,
+  /// `out` and `err`: rank 0's log streams (streams that drop what they are given on the other processes).
+  TimeLoop(SimulationInterface& sim, ScenarioRun& scenario, RunOutput& output, const RunSettings& settings, std::ostream& out,
            std::ostream& err);
   TimeLoop(const TimeLoop&) = delete;
   TimeLoop& operator=(const TimeLoop&) = delete;
@@ -29,17 +31,19 @@ class TimeLoop {
   /// (InputError) removes the run's files (RunOutput::discard) and passes through.
   int run();
 
-  /// Steps taken, the wall time spent in Simulation::advance (failed calls included), and its parts.
+  /// Steps taken, the wall time spent in advance() (failed calls included), and its parts on this process.
   long steps() const { return steps_; }
   double stepping_seconds() const { return stepping_; }
-  StepTimings timings() const { return sim_.op().timings().since(timings_at_start_); }
+  StepTimings timings() const { return sim_.timings().since(timings_at_start_); }
 
  private:
   void step_once();
   void log(const std::string& message);
   void write_failed(const WriteError& e);
+  /// Whether any process received a stop signal (its number kept for the last line). Collective.
+  bool stop_signal();
 
-  Simulation& sim_;
+  SimulationInterface& sim_;
   ScenarioRun& scenario_;
   RunOutput& output_;
   std::ostream& out_;
@@ -47,7 +51,7 @@ class TimeLoop {
   StepRecord last_;  ///< of the last accepted step (the diagnostics rows report it)
   std::vector<Callback> callbacks_;
   Progress progress_;
-  int status_ = 0;
+  int status_ = 0, signal_ = 0;
   long steps_ = 0;
   double stepping_ = 0;
   StepTimings timings_at_start_;

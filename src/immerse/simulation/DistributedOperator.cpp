@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <array>
+#include <chrono>
 #include <optional>
 #include <stdexcept>
 #include <utility>
@@ -12,8 +13,23 @@
 #include "immerse/coupling/NodeDiagnostics.hpp"
 #include "immerse/parallel/Agreement.hpp"
 #include "immerse/simulation/InversionReport.hpp"
+#include "immerse/timestep/LogEvent.hpp"
 
 namespace immerse {
+
+namespace {
+
+/// Runs f as a phase of the step profile: its wall time on this process is added to `seconds`, and it is PETSc's
+/// log event `phase` (as in ImmersedBoundaryOperator).
+template <class F>
+void timed(double& seconds, Phase phase, F&& f) {
+  const LogEvent event(phase);
+  const auto t0 = std::chrono::steady_clock::now();
+  f();
+  seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+}  // namespace
 
 namespace {
 
@@ -62,7 +78,7 @@ DistributedOperator::DistributedOperator(SlabNavierStokesSolver& fluid, SlabIBCo
   }
   refresh();
   U_.resize(X_.size());
-  coupler_.interpolate_velocity(committed_.u, X_, U_);
+  timed(timings_.interpolate, Phase::Interpolation, [&] { coupler_.interpolate_velocity(committed_.u, X_, U_); });
 }
 
 void DistributedOperator::update_indicator(std::span<const Vec3> Xf) {
@@ -96,21 +112,24 @@ void DistributedOperator::nodal_forces(std::span<const Vec3> Xf) {
   Fm_.resize(owned.size());
   std::string error;
   std::size_t failed = owned.size();
-  for (std::size_t k = 0; k < owned.size() && error.empty(); ++k) {
-    const std::span<const Vec3> Xm = Xf.subspan(offset_[k], offset_[k + 1] - offset_[k]);
-    try {
-      check_nodes_in_domain(fluid_.grid(), Xm);
-      membranes_[static_cast<std::size_t>(owned[k].id)]->compute_force(Xm, Fm_[k]);
-    } catch (const SimulationError& e) {
-      error = e.what();
-      failed = k;
+  timed(timings_.force, Phase::MembraneForces, [&] {
+    for (std::size_t k = 0; k < owned.size() && error.empty(); ++k) {
+      const std::span<const Vec3> Xm = Xf.subspan(offset_[k], offset_[k + 1] - offset_[k]);
+      try {
+        check_nodes_in_domain(fluid_.grid(), Xm);
+        membranes_[static_cast<std::size_t>(owned[k].id)]->compute_force(Xm, Fm_[k]);
+      } catch (const SimulationError& e) {
+        error = e.what();
+        failed = k;
+      }
+      if (error.empty())
+        std::copy(Fm_[k].begin(), Fm_[k].end(), F_.begin() + static_cast<std::ptrdiff_t>(offset_[k]));
     }
-    if (error.empty()) std::copy(Fm_[k].begin(), Fm_[k].end(), F_.begin() + static_cast<std::ptrdiff_t>(offset_[k]));
-  }
+  });
   if (any_failed(fluid_.decomposition().communicator(), !error.empty()))
     throw SimulationError(failure_report(Xf, failed, error));
   // After the membranes, which have checked that every node is finite and inside the box.
-  if (contact_.range > 0) add_contact_forces(Xf);
+  if (contact_.range > 0) timed(timings_.contact, Phase::Contact, [&] { add_contact_forces(Xf); });
 }
 
 // The lowest-ranked failing process's message on every process; for an inverted element, with where it stands, the
@@ -249,11 +268,11 @@ void DistributedOperator::trial_step(std::span<const double> Xf, double theta, d
   trial_done_ = false;
   if (theta < 1.0 && !start_valid_) {  // S(X^n) f(X^n), once per step unless the last trial left it
     nodal_forces(X_);
-    coupler_.spread_force(X_, F_, force_start_);
+    timed(timings_.spread, Phase::Spreading, [&] { coupler_.spread_force(X_, F_, force_start_); });
     start_valid_ = true;
   }
   nodal_forces(nodes(Xf));
-  coupler_.spread_force(nodes(Xf), F_, force_);
+  timed(timings_.spread, Phase::Spreading, [&] { coupler_.spread_force(nodes(Xf), F_, force_); });
   if (theta < 1.0) {  // F^{n+1/2} = theta S(Xf) f(Xf) + (1 - theta) S(X^n) f(X^n), as ImmersedBoundaryOperator
     mixed_ = force_;
     for (int d = 0; d < 3; ++d) {
@@ -263,15 +282,17 @@ void DistributedOperator::trial_step(std::span<const double> Xf, double theta, d
       for (std::size_t i = 0; i < o.size(); ++i) o[i] = theta * x[i] + (1.0 - theta) * y[i];
     }
   }
-  if (indicator_) update_indicator(nodes(Xf));
-  fluid_.step(committed_, theta < 1.0 ? mixed_ : force_, dt, trial_, indicator_ ? &chi_ : nullptr);
+  timed(timings_.fluid, Phase::FluidStep, [&] {
+    if (indicator_) update_indicator(nodes(Xf));
+    fluid_.step(committed_, theta < 1.0 ? mixed_ : force_, dt, trial_, indicator_ ? &chi_ : nullptr);
+  });
   ++solves_;
 }
 
 void DistributedOperator::trial_velocity(std::span<const double> Xf, double theta, std::span<const double> Xi,
                                          double dt, std::span<double> U) {
   trial_step(Xf, theta, dt);
-  coupler_.interpolate_velocity(trial_.u, nodes(Xi), nodes(U));
+  timed(timings_.interpolate, Phase::Interpolation, [&] { coupler_.interpolate_velocity(trial_.u, nodes(Xi), nodes(U)); });
   trial_X_.assign(Xf.begin(), Xf.end());
   trial_done_ = true;
 }
@@ -287,13 +308,13 @@ void DistributedOperator::trial_mean_velocity(std::span<const double> Xf, std::s
     const auto& y = committed_.u[d].values();
     for (std::size_t i = 0; i < o.size(); ++i) o[i] = 0.5 * x[i] + 0.5 * y[i];
   }
-  coupler_.interpolate_velocity(mean_, nodes(Xi), nodes(U));
+  timed(timings_.interpolate, Phase::Interpolation, [&] { coupler_.interpolate_velocity(mean_, nodes(Xi), nodes(U)); });
   trial_X_.assign(Xf.begin(), Xf.end());
   trial_done_ = true;
 }
 
 void DistributedOperator::committed_velocity(std::span<const double> Xi, std::span<double> U) {
-  coupler_.interpolate_velocity(committed_.u, nodes(Xi), nodes(U));
+  timed(timings_.interpolate, Phase::Interpolation, [&] { coupler_.interpolate_velocity(committed_.u, nodes(Xi), nodes(U)); });
 }
 
 void DistributedOperator::correct_positions(std::span<const Vec3> X) {
@@ -321,7 +342,7 @@ void DistributedOperator::move_to(std::span<const Vec3> X) {
   migrations_ += ownership_.migrate();
   refresh();
   U_.resize(X_.size());
-  coupler_.interpolate_velocity(committed_.u, X_, U_);
+  timed(timings_.interpolate, Phase::Interpolation, [&] { coupler_.interpolate_velocity(committed_.u, X_, U_); });
   trial_X_.clear();
   trial_done_ = false;
 }

@@ -58,6 +58,7 @@
 #include "immerse/membrane/ElasticMembrane.hpp"
 #include "immerse/parallel/MembraneOwnership.hpp"
 #include "immerse/simulation/ContactForce.hpp"
+#include "immerse/simulation/StepTimings.hpp"
 #include "immerse/timestep/CoupledOperator.hpp"
 
 namespace immerse {
@@ -98,6 +99,8 @@ class DistributedOperator final : public CoupledOperator {
   const FluidState& fluid_state() const { return committed_; }
   /// Membranes moved to another process by the commits and corrections so far (the same on every process).
   int migrations() const { return migrations_; }
+  /// Wall time of this process in each part of the step so far.
+  const StepTimings& timings() const { return timings_; }
   /// χ of the last trial on this process's slab (empty without a viscosity contrast).
   const Array3& viscosity_indicator() const { return chi_; }
   /// Replaces the committed positions of the owned nodes by X (concatenated as positions()) after an accepted step:
@@ -150,6 +153,7 @@ class DistributedOperator final : public CoupledOperator {
   Array3 chi_;                                       ///< χ of the last trial (slab)
   std::size_t solves_ = 0;
   int migrations_ = 0;
+  StepTimings timings_;
 };
 
 }  // namespace immerse

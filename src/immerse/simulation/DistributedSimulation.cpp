@@ -3,11 +3,18 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <limits>
+#include <optional>
 #include <sstream>
 #include <string>
 
 #include "immerse/core/Error.hpp"
 #include "immerse/coupling/DeltaKernel.hpp"
+#include "immerse/coupling/NodeDiagnostics.hpp"
+#include "immerse/fluid/FluidDiagnostics.hpp"
+#include "immerse/io/CellFields.hpp"
+#include "immerse/io/ParallelCheckpoint.hpp"
+#include "immerse/io/ParallelHdf5.hpp"
 #include "immerse/membrane/VolumeCorrection.hpp"
 #include "immerse/parallel/Agreement.hpp"
 #include "immerse/simulation/CheckpointEntries.hpp"
@@ -27,14 +34,25 @@ const io::Config& distributable(const io::Config& config) {
 
 }  // namespace
 
-DistributedSimulation::DistributedSimulation(const io::Config& config, Communicator comm)
+namespace {
+
+/// The stop query of every process agreed: true on all when it is true on any. Collective in each call.
+std::function<bool()> agreed(const Communicator& comm, const std::function<bool()>& stop_requested) {
+  if (!stop_requested) return {};
+  return [comm, stop_requested] { return max_over_processes(comm, stop_requested() ? 1 : 0) > 0; };
+}
+
+}  // namespace
+
+DistributedSimulation::DistributedSimulation(const io::Config& config, Communicator comm,
+                                             const StopQuery& stop_requested)
     : config_(distributable(config)),
       end_time_(config.get<double>("time.end")),
       max_speed_(config.get<double>("time.max_speed")),
       grid_(run_grid(config)),
       fluid_(grid_, run_fluid_params(config), comm),
       coupler_(fluid_.decomposition(), delta_kernel(config.get<std::string>("coupling.kernel"))),
-      membranes_(build_membrane_set(config, grid_)),
+      membranes_(build_membrane_set(config, grid_, agreed(comm, stop_requested))),
       stepper_(config.get<double>("time.dt"), config.get<double>("time.dt_min")) {
   std::vector<const ElasticMembrane*> ms;
   for (const auto& m : membranes_.membranes) ms.push_back(m.get());
@@ -90,7 +108,7 @@ void DistributedSimulation::start_budget() {
 
 bool DistributedSimulation::finished() const { return time() >= end_time_ * (1 - 1e-12); }
 
-StepRecord DistributedSimulation::advance(const std::function<void(const std::string&)>& log) {
+StepRecord DistributedSimulation::advance(const Log& log, const StopQuery& stop_requested) {
   const auto t0 = std::chrono::steady_clock::now();
   std::ostringstream where;
   where.precision(10);
@@ -98,9 +116,12 @@ StepRecord DistributedSimulation::advance(const std::function<void(const std::st
   const int migrated = op_->migrations();
   StepRecord r;
   try {
-    const auto acc = stepper_.advance(*integrator_, *op_, end_time_ - time(), [&](const std::string& msg) {
-      if (log) log(where.str() + msg);
-    });
+    const auto acc = stepper_.advance(
+        *integrator_, *op_, end_time_ - time(),
+        [&](const std::string& msg) {
+          if (log) log(where.str() + msg);
+        },
+        agreed(communicator(), stop_requested));
     r.stats = acc.stats;
     r.dt = acc.dt;
     r.rejected = acc.rejected;
@@ -290,6 +311,274 @@ void DistributedSimulation::restore(const io::Checkpoint& ck) {
   stepper_.set_state(dt, static_cast<int>(successes));
   step_ = step;
   if (!budget_.restore(ck)) start_budget();
+}
+
+namespace {
+
+/// Node offsets of the membranes in the global concatenation (global membrane order), and of their triangles.
+struct GlobalLayout {
+  std::vector<std::size_t> node, triangle;  ///< M + 1 entries each
+
+  explicit GlobalLayout(const MembraneSet& set) : node{0}, triangle{0} {
+    for (std::size_t m = 0; m < set.meshes.size(); ++m) {
+      node.push_back(node.back() + set.references[m].size());
+      triangle.push_back(triangle.back() + set.meshes[m].elements.size());
+    }
+  }
+};
+
+/// The z planes [begin, end) of the global array of `layout` this process holds, and their values in its slab.
+std::span<const double> held_values(const SlabDecomposition& slabs, const Array3& local, Layout layout,
+                                    PlaneRange& planes) {
+  planes = slabs.held(layout);
+  const std::size_t plane = static_cast<std::size_t>(local.nx()) * local.ny();
+  return {local.data() + local.index(0, 0, planes.begin - slabs.offset()), plane * planes.count()};
+}
+
+}  // namespace
+
+void DistributedSimulation::write_checkpoint(const std::filesystem::path& file, const Attributes& attributes,
+                                             const std::function<void(io::Checkpoint&)>& extra) const {
+  const DistributedSimulation& sim = *this;
+  const SlabDecomposition& slabs = sim.fluid().decomposition();
+  const Communicator& comm = slabs.communicator();
+  io::ParallelCheckpoint ck(comm);
+  ck.put_string("config", sim.config().to_toml_string());
+  ck.put_int("step", sim.step());
+  const FluidState& f = sim.op().fluid_state();
+  const auto put_field = [&](const std::string& name, const Array3& local, Layout layout) {
+    PlaneRange planes;
+    const auto values = held_values(slabs, local, layout, planes);
+    const auto s =
+        layout == Layout::Pressure ? sim.grid().cell_shape() : sim.grid().face_shape(static_cast<int>(layout));
+    const std::size_t plane = std::size_t(s[0]) * std::size_t(s[1]);
+    ck.put_array(name, {std::size_t(s[2]), std::size_t(s[1]), std::size_t(s[0])},
+                 {{planes.begin * plane, {values.begin(), values.end()}}});
+  };
+  for (int d = 0; d < 3; ++d) {
+    put_field("fluid.u" + std::to_string(d), f.u[d], velocity_layout(d));
+    put_field("fluid.adv" + std::to_string(d), f.adv[d], velocity_layout(d));
+    // u^{n-1} of a variable viscosity, as in one process (a slab array on every process alike, or on none).
+    if (f.u_prev[d].size() == f.u[d].size())
+      put_field("fluid.u_prev" + std::to_string(d), f.u_prev[d], velocity_layout(d));
+  }
+  put_field("fluid.p", f.p, Layout::Pressure);
+  put_field("fluid.p_prev", f.p_prev, Layout::Pressure);
+  ck.put_double("fluid.dt_prev", f.dt_prev);
+  ck.put_double("fluid.dt_prev2", f.dt_prev2);
+  ck.put_int("fluid.step", f.step);
+  ck.put_double("fluid.time", f.time);
+  const auto& owned = sim.op().ownership().owned();
+  const auto flat = [](const std::vector<Vec3>& v) { return std::vector<double>(&v[0].x, &v[0].x + 3 * v.size()); };
+  for (std::size_t m = 0; m < sim.num_membranes(); ++m) {
+    const std::string name = "membrane[" + std::to_string(m) + "]";
+    const std::size_t n = sim.membranes().references[m].size();
+    std::vector<io::ParallelCheckpoint::Piece> X, R;
+    for (const OwnedMembrane& o : owned)
+      if (static_cast<std::size_t>(o.id) == m) {
+        X.push_back({0, flat(o.positions)});
+        R.push_back({0, flat(o.reference)});
+      }
+    ck.put_array(name + ".positions", {n, 3}, std::move(X));
+    ck.put_array(name + ".reference", {n, 3}, std::move(R));
+  }
+  // The integrator's history, per node in global membrane order: vectors of all unknowns one after the other.
+  const GlobalLayout layout(sim.membranes());
+  const std::size_t unknowns = 3 * layout.node.back();
+  const std::size_t local = 3 * sim.op().ownership().num_owned_nodes();
+  const auto put_history = [&](const std::string& name, const std::vector<double>& values) {
+    const int vectors = max_over_processes(comm, local > 0 ? static_cast<int>(values.size() / local) : 0);
+    std::vector<io::ParallelCheckpoint::Piece> pieces;
+    std::size_t at = 0;
+    for (int k = 0; k < vectors && local > 0; ++k)
+      for (const OwnedMembrane& o : owned) {
+        const std::size_t n = 3 * o.positions.size();
+        pieces.push_back(
+            {k * unknowns + 3 * layout.node[static_cast<std::size_t>(o.id)],
+             {values.begin() + static_cast<std::ptrdiff_t>(at), values.begin() + static_cast<std::ptrdiff_t>(at + n)}});
+        at += n;
+      }
+    ck.put_array(name, {static_cast<std::size_t>(vectors) * unknowns}, std::move(pieces));
+  };
+  put_history("integrator.previous_positions", sim.integrator().previous_positions());
+  ck.put_double("integrator.previous_dt", sim.integrator().previous_dt());
+  put_history("integrator.guess_errors", sim.integrator().guess_errors().errors());
+  ck.put_double("stepper.dt", sim.stepper().dt());
+  ck.put_int("stepper.successes", sim.stepper().successes());
+  for (const auto& [name, value] : sim.energy_budget().entries()) ck.put_double(name, value);
+  if (extra) {
+    io::Checkpoint more;
+    extra(more);
+    if (more.checksum() != io::Checkpoint().checksum())
+      throw std::logic_error("DistributedSimulation::write_checkpoint: a scenario's own entries are not distributed");
+  }
+  ck.set_attributes(attributes);
+  ck.write(file);
+}
+
+void DistributedSimulation::write_frame(io::XdmfWriter* series, const std::filesystem::path& dir, int frame,
+                                       const Attributes& attributes, bool fluid_fields) const {
+  const DistributedSimulation& sim = *this;
+  const SlabDecomposition& slabs = sim.fluid().decomposition();
+  const Communicator& comm = slabs.communicator();
+  const MembraneSet& set = sim.membranes();
+  const GlobalLayout layout(set);
+  const auto& owned = sim.op().ownership().owned();
+  const auto offsets = sim.op().membrane_offsets();
+  const auto U = sim.op().node_velocity();
+  // The owned membranes' rows, in ascending global order.
+  std::vector<double> X, F, V, tau1, tau2;
+  std::vector<std::int32_t> conn, id;
+  std::vector<io::phdf5::Rows> node_rows, triangle_rows;
+  std::string error;
+  for (std::size_t k = 0; k < owned.size() && error.empty(); ++k) {
+    const auto m = static_cast<std::size_t>(owned[k].id);
+    const auto& Xm = owned[k].positions;
+    std::vector<Vec3> Fm;
+    try {
+      set.membranes[m]->compute_force(Xm, Fm);
+      for (const auto& s : set.membranes[m]->node_strain(Xm)) tau1.push_back(s.tau1), tau2.push_back(s.tau2);
+    } catch (const SimulationError& e) {
+      error = "membrane[" + std::to_string(m) + "] " + e.what();
+      break;
+    }
+    for (std::size_t i = 0; i < Xm.size(); ++i) {
+      X.insert(X.end(), {Xm[i].x, Xm[i].y, Xm[i].z});
+      F.insert(F.end(), {Fm[i].x, Fm[i].y, Fm[i].z});
+    }
+    V.insert(V.end(), U.begin() + static_cast<std::ptrdiff_t>(offsets[k]),
+             U.begin() + static_cast<std::ptrdiff_t>(offsets[k + 1]));
+    for (const auto& tri : set.meshes[m].elements)
+      for (const int v : tri) conn.push_back(static_cast<std::int32_t>(layout.node[m]) + v);
+    id.insert(id.end(), set.meshes[m].elements.size(), static_cast<std::int32_t>(m));
+    node_rows.push_back({layout.node[m], Xm.size()});
+    triangle_rows.push_back({layout.triangle[m], set.meshes[m].elements.size()});
+  }
+  if (const std::string first = first_error(comm, error); !first.empty()) throw SimulationError(first);
+
+  const std::string file = io::XdmfWriter::frame_file_name(frame);
+  const std::size_t M = sim.num_membranes(), nn = layout.node.back(), nt = layout.triangle.back();
+  std::string names;
+  for (std::size_t m = 0; m < M; ++m) names += (m ? " membrane" : "membrane") + std::to_string(m);
+  const std::string mx = io::XdmfWriter::membranes_fragment(
+      file, frame, sim.time(), names, nn, nt, {{"force", 3}, {"velocity", 3}, {"tension_1", 1}, {"tension_2", 1}});
+  const std::string fx = fluid_fields ? io::XdmfWriter::fluid_fragment(file, frame, sim.time(), sim.grid()) : "";
+  // The cell-centred velocity and vorticity need neighbouring planes: every process computes them on the gathered
+  // velocity and writes its own cell planes.
+  std::optional<io::CellFields> cells;
+  if (fluid_fields) cells = io::CellFields::from_faces(sim.grid(), sim.fluid().gather(sim.op().fluid_state().u));
+  const bool root = comm.rank() == 0;
+  io::phdf5::write_file_atomically(dir / file, comm, [&](hid_t h5) {
+    std::string failed;
+    const auto check = [&](bool ok, const std::string& what) {
+      if (!ok && failed.empty()) failed = "HDF5 error writing " + what;
+    };
+    check(io::hdf5::write_attribute(h5, "time", sim.time()), "time");
+    for (const auto& [name, value] : attributes) check(io::hdf5::write_attribute(h5, name, value), name);
+    {
+      io::hdf5::Handle g = io::hdf5::create_group(h5, "membranes");
+      check(g.valid() && io::hdf5::write_attribute(g.get(), "names", names), "/membranes");
+      using io::phdf5::Rows;
+      check(io::phdf5::write_doubles(g.get(), "nodes", {nn, 3}, node_rows, X.data()), "/membranes/nodes");
+      check(io::phdf5::write_int32(g.get(), "connectivity", {nt, 6}, triangle_rows, conn.data()),
+            "/membranes/connectivity");
+      check(io::phdf5::write_int32(g.get(), "membrane_id", {nt}, triangle_rows, id.data()), "/membranes/membrane_id");
+      std::vector<std::int64_t> node_offsets(layout.node.begin(), layout.node.end());
+      const Rows all{0, node_offsets.size()};
+      check(
+          io::phdf5::write_int64(g.get(), "node_offsets", {node_offsets.size()},
+                                 root ? std::span<const Rows>(&all, 1) : std::span<const Rows>(), node_offsets.data()),
+          "/membranes/node_offsets");
+      check(io::phdf5::write_doubles(g.get(), "force", {nn, 3}, node_rows, F.data()), "/membranes/force");
+      check(io::phdf5::write_doubles(g.get(), "velocity", {nn, 3}, node_rows, V.data()), "/membranes/velocity");
+      check(io::phdf5::write_doubles(g.get(), "tension_1", {nn}, node_rows, tau1.data()), "/membranes/tension_1");
+      check(io::phdf5::write_doubles(g.get(), "tension_2", {nn}, node_rows, tau2.data()), "/membranes/tension_2");
+      check(g.close(), "/membranes");
+    }
+    if (fluid_fields) {
+      const auto& n = sim.grid().n();
+      const PlaneRange z = slabs.cells();
+      const std::size_t plane = std::size_t(n[0]) * std::size_t(n[1]), first = plane * std::size_t(z.begin);
+      const std::size_t count = plane * std::size_t(z.count());
+      std::vector<double> vel(3 * count);
+      for (std::size_t c = 0; c < count; ++c)
+        for (int d = 0; d < 3; ++d) vel[3 * c + d] = cells->velocity[d].data()[first + c];
+      PlaneRange planes;
+      const auto p = held_values(slabs, sim.op().fluid_state().p, Layout::Pressure, planes);
+      const io::phdf5::Rows rows{hsize_t(z.begin), hsize_t(z.count())};
+      const std::vector<hsize_t> sdims{hsize_t(n[2]), hsize_t(n[1]), hsize_t(n[0])};
+      io::hdf5::Handle fg = io::hdf5::create_group(h5, "fluid");
+      check(fg.valid(), "/fluid");
+      check(io::phdf5::write_doubles(fg.get(), "velocity", {sdims[0], sdims[1], sdims[2], 3}, {&rows, 1}, vel.data()),
+            "/fluid/velocity");
+      check(io::phdf5::write_doubles(fg.get(), "pressure", sdims, {&rows, 1}, p.data()), "/fluid/pressure");
+      check(io::phdf5::write_doubles(fg.get(), "vorticity_magnitude", sdims, {&rows, 1},
+                                     cells->vorticity_magnitude.data() + first),
+            "/fluid/vorticity_magnitude");
+      check(fg.close(), "/fluid");
+    }
+    check(io::hdf5::write_attribute(h5, io::XdmfWriter::kMembranesAttribute, mx) &&
+              io::hdf5::write_attribute(h5, io::XdmfWriter::kFluidAttribute, fx),
+          "XDMF fragments");
+    return failed;
+  });
+  // The series names the frame once every process has written it (rank 0 alone writes the XDMF files).
+  std::string failed;
+  if (series) try {
+      series->append_frame(mx, fx);
+    } catch (const WriteError& e) {
+      failed = e.what();
+    }
+  if (const std::string first = first_error(comm, failed); !first.empty()) throw WriteError(first);
+}
+
+double DistributedSimulation::mean_velocity(int d) const {
+  PlaneRange planes;
+  const auto v = held_values(fluid_.decomposition(), op_->fluid_state().u[d], velocity_layout(d), planes);
+  double sum = 0;
+  for (double x : v) sum += x;
+  const auto s = grid_.face_shape(d);
+  return communicator().sum(sum) / (double(s[0]) * s[1] * s[2]);
+}
+
+double DistributedSimulation::wall_shear_stress(bool upper, double mu, double wall_velocity_x) const {
+  const SlabDecomposition& slabs = fluid_.decomposition();
+  const Array3& ux = op_->fluid_state().u[0];
+  const Array3* chi = &op_->viscosity_indicator();
+  double mine = 0;
+  if (!upper && slabs.first()) mine = wall_shear_stress_sum(grid_, ux, chi, false, wall_velocity_x, 0 - slabs.offset());
+  if (upper && slabs.last())
+    mine = wall_shear_stress_sum(grid_, ux, chi, true, wall_velocity_x, grid_.n(2) - 1 - slabs.offset());
+  return mu / (double(grid_.n(0)) * double(grid_.n(1))) * communicator().sum(mine);
+}
+
+double DistributedSimulation::min_wall_distance() const {
+  const auto X = op_->positions();
+  double mine = std::numeric_limits<double>::infinity();
+  try {
+    mine = immerse::min_wall_distance(grid_, {reinterpret_cast<const Vec3*>(X.data()), X.size() / 3});
+  } catch (const SimulationError&) {
+    mine = -1;  // a node outside the box: the next step reports it
+  }
+  const double all = min_over_processes(communicator(), mine);
+  return all < 0 ? std::numeric_limits<double>::quiet_NaN() : all;
+}
+
+std::string DistributedSimulation::decomposition_summary() const {
+  const SlabDecomposition& slabs = fluid_.decomposition();
+  return "distributed over " + std::to_string(communicator().size()) + " MPI processes: slabs of " +
+         std::to_string(slabs.block()) + " z planes of " + std::to_string(grid_.n(2));
+}
+
+std::string DistributedSimulation::thread_policy() const {
+  return std::to_string(communicator().size()) + " MPI processes, each with the OpenMP threads OMP_NUM_THREADS gives it";
+}
+
+std::string DistributedSimulation::thread_summary() const { return "threads: " + thread_policy(); }
+
+void DistributedSimulation::set_applied_forces(std::size_t m, const std::vector<Vec3>& /*F*/) {
+  throw InputError("membrane[" + std::to_string(m) + "]: applied nodal forces (scenario.kind = \"rbc_stretch\") are "
+                   "not distributed over MPI processes (run it in one process)");
 }
 
 }  // namespace immerse

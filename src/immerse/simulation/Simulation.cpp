@@ -7,6 +7,7 @@
 
 #include "immerse/core/Error.hpp"
 #include "immerse/coupling/NodeDiagnostics.hpp"
+#include "immerse/fluid/FluidDiagnostics.hpp"
 #include "immerse/membrane/VolumeCorrection.hpp"
 #include "immerse/simulation/CheckpointEntries.hpp"
 #include "immerse/simulation/MembraneSet.hpp"
@@ -67,16 +68,14 @@ MembraneEnergy Simulation::membrane_energy(std::size_t m) const {
 }
 
 void Simulation::start_budget() {
-  std::vector<MembraneEnergy> parts;
-  for (std::size_t m = 0; m < num_membranes(); ++m) parts.push_back(membrane_energy(m));
+  const std::vector<MembraneEnergy> parts = membrane_energies();
   const FluidEnergy fluid = fluid_energy();
   budget_.start(total_energy(fluid.kinetic, parts), fluid);
 }
 
 bool Simulation::finished() const { return time() >= end_time_ * (1 - 1e-12); }
 
-StepRecord Simulation::advance(const std::function<void(const std::string&)>& log,
-                               const std::function<bool()>& stop_requested) {
+StepRecord Simulation::advance(const Log& log, const StopQuery& stop_requested) {
   const auto t0 = std::chrono::steady_clock::now();
   const double remaining = end_time_ - time();
   StepRecord r;
@@ -259,6 +258,67 @@ void Simulation::restore(const io::Checkpoint& ck) {
   stepper_.set_state(dt, static_cast<int>(successes));
   step_ = step;
   if (!budget_.restore(ck)) start_budget();
+}
+
+std::vector<std::vector<Vec3>> Simulation::positions() const {
+  std::vector<std::vector<Vec3>> X;
+  for (std::size_t m = 0; m < num_membranes(); ++m) X.push_back(op_->membrane_positions(m));
+  return X;
+}
+
+std::vector<MembraneEnergy> Simulation::membrane_energies() const {
+  std::vector<MembraneEnergy> parts;
+  for (std::size_t m = 0; m < num_membranes(); ++m) parts.push_back(membrane_energy(m));
+  return parts;
+}
+
+double Simulation::mean_velocity(int d) const {
+  const auto& v = op_->fluid_state().u[d].values();
+  double sum = 0;
+  for (double x : v) sum += x;
+  return sum / double(v.size());
+}
+
+double Simulation::wall_shear_stress(bool upper, double mu, double wall_velocity_x) const {
+  return immerse::wall_shear_stress(grid_, op_->fluid_state().u, &op_->viscosity_indicator(), mu, upper,
+                                    wall_velocity_x);
+}
+
+void Simulation::write_checkpoint(const std::filesystem::path& file, const Attributes& attributes,
+                                  const std::function<void(io::Checkpoint&)>& extra) const {
+  io::Checkpoint ck = checkpoint();
+  if (extra) extra(ck);
+  ck.set_attributes(attributes);
+  ck.write(file);
+}
+
+void Simulation::write_frame(io::XdmfWriter* series, const std::filesystem::path& /*dir*/, int frame,
+                             const Attributes& attributes, bool fluid_fields) const {
+  if (!series || series->frames() != frame)
+    throw std::logic_error("Simulation::write_frame: the series is not at frame " + std::to_string(frame));
+  std::vector<std::vector<Vec3>> X, U, F;
+  std::vector<std::vector<double>> tau1, tau2;
+  std::vector<io::SurfaceFrame> frames;
+  for (std::size_t m = 0; m < num_membranes(); ++m) {
+    X.push_back(op_->membrane_positions(m));
+    U.push_back(op_->membrane_velocities(m));
+    F.emplace_back();
+    membrane(m).compute_force(X.back(), F.back());
+    const auto strain = membrane(m).node_strain(X.back());
+    tau1.emplace_back();
+    tau2.emplace_back();
+    for (const auto& s : strain) tau1.back().push_back(s.tau1), tau2.back().push_back(s.tau2);
+  }
+  for (std::size_t m = 0; m < num_membranes(); ++m)
+    frames.push_back({"membrane" + std::to_string(m),
+                      X[m],
+                      mesh(m).elements,
+                      {{"force", F[m]}, {"velocity", U[m]}},
+                      {{"tension_1", tau1[m]}, {"tension_2", tau2[m]}}});
+  const auto& f = op_->fluid_state();
+  const io::FluidFrame fluid{grid_, f.u, f.p};
+  series->set_attributes(attributes);
+  series->write_frame(time(), frames, fluid_fields ? &fluid : nullptr);
 }
 
 }  // namespace immerse
