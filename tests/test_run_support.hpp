@@ -59,6 +59,14 @@ inline std::string read_text(const fs::path& path) {
 }
 
 /// A started `immerse ARGS...` with its stdout and stderr going to files.
+/// Whether process `pid` catches SIGTERM (its handler is installed: SigCgt of /proc/PID/status has bit 15).
+inline bool catches_sigterm(pid_t pid) {
+  std::istringstream status(read_text("/proc/" + std::to_string(pid) + "/status"));
+  for (std::string line; std::getline(status, line);)
+    if (line.rfind("SigCgt:", 0) == 0) return (std::stoull(line.substr(7), nullptr, 16) >> (SIGTERM - 1)) & 1u;
+  return false;
+}
+
 class ImmerseProcess {
  public:
   /// `env`: NAME=VALUE entries set for the child (replacing inherited ones of the same name); a bare NAME removes it.
@@ -115,6 +123,7 @@ class ImmerseProcess {
   ImmerseProcess& operator=(const ImmerseProcess&) = delete;
 
   void signal(int sig) const { kill(pid_, sig); }
+  pid_t pid() const { return pid_; }
   /// Waits for the end: the exit status, or 128 + the signal that killed it.
   int wait() {
     int st = 0;

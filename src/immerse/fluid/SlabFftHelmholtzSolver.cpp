@@ -15,16 +15,17 @@ namespace immerse {
 
 SlabFftHelmholtzSolver::SlabFftHelmholtzSolver(const Grid& grid, Layout layout, Communicator comm)
     : layout_(layout), comm_(comm) {
-  plan(grid, 0);
+  plan(grid, 0, FftPlanning::Estimate);
 }
 
-SlabFftHelmholtzSolver::SlabFftHelmholtzSolver(const Grid& grid, Layout layout, Communicator comm, int block)
+SlabFftHelmholtzSolver::SlabFftHelmholtzSolver(const Grid& grid, Layout layout, Communicator comm, int block,
+                                               FftPlanning planning)
     : layout_(layout), comm_(comm) {
   if (block < 1) throw std::invalid_argument("SlabFftHelmholtzSolver: the block of planes must be at least 1");
-  plan(grid, block);
+  plan(grid, block, planning);
 }
 
-void SlabFftHelmholtzSolver::plan(const Grid& grid, int block) {
+void SlabFftHelmholtzSolver::plan(const Grid& grid, int block, FftPlanning planning) {
   shape_ = layout_ == Layout::Pressure ? grid.cell_shape() : grid.face_shape(static_cast<int>(layout_));
   std::array<fftw_r2r_kind, 3> fwd{}, bwd{};
   for (int a = 0; a < 3; ++a) {
@@ -59,8 +60,10 @@ void SlabFftHelmholtzSolver::plan(const Grid& grid, int block) {
   buf_ = fftw_alloc_real(static_cast<std::size_t>(alloc > 0 ? alloc : 1));
   if (buf_ == nullptr) throw std::bad_alloc();
   const fftw_r2r_kind fk[3] = {fwd[2], fwd[1], fwd[0]}, bk[3] = {bwd[2], bwd[1], bwd[0]};
-  forward_ = fftw_mpi_plan_many_r2r(3, n, 1, b, b, buf_, buf_, comm_.comm(), fk, FFTW_ESTIMATE);
-  backward_ = fftw_mpi_plan_many_r2r(3, n, 1, b, b, buf_, buf_, comm_.comm(), bk, FFTW_ESTIMATE);
+  // Measuring overwrites buf_, which holds nothing yet.
+  const unsigned flags = planning == FftPlanning::Measure ? FFTW_MEASURE : FFTW_ESTIMATE;
+  forward_ = fftw_mpi_plan_many_r2r(3, n, 1, b, b, buf_, buf_, comm_.comm(), fk, flags);
+  backward_ = fftw_mpi_plan_many_r2r(3, n, 1, b, b, buf_, buf_, comm_.comm(), bk, flags);
   if (forward_ == nullptr || backward_ == nullptr) {
     if (forward_) fftw_destroy_plan(forward_);
     if (backward_) fftw_destroy_plan(backward_);

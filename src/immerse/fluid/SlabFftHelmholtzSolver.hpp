@@ -13,7 +13,8 @@
 //                                   ⌈M_z / P⌉ planes per process, the last processes fewer or none),
 // in its own Array3 of local_shape() = {S_x, S_y, n_r}: plane k of it is plane first().z + z0_r + k of the layout's
 // global array, with that array's full x and y extent (S_x, S_y; wall faces of x or y included and left untouched).
-// The forward 3D r2r transform (fftw_mpi_plan_r2r_3d, FFTW_ESTIMATE: the same plan on every run) returns the
+// The forward 3D r2r transform (fftw_mpi_plan_many_r2r; FFTW_ESTIMATE, the same plan on every run, unless the caller
+// asks FftPlanning::Measure, whose timings FFTW-MPI reduces over the processes so that all choose alike) returns the
 // coefficients in the same distribution, so each process divides its planes k by the symbol at global k = z0_r + k.
 // FFTW-MPI transposes through an internal buffer of fftw_mpi_local_size_3d values, which can exceed n_r M_y M_x.
 // More processes than planes (P > M_z) is refused (std::invalid_argument). A caller that shares planes between
@@ -45,7 +46,8 @@ class SlabFftHelmholtzSolver {
   SlabFftHelmholtzSolver(const Grid& grid, Layout layout, Communicator comm);
   /// The same with `block` planes per process (the last ones fewer or none); std::invalid_argument unless
   /// block ≥ 1 and block · P ≥ M_z.
-  SlabFftHelmholtzSolver(const Grid& grid, Layout layout, Communicator comm, int block);
+  SlabFftHelmholtzSolver(const Grid& grid, Layout layout, Communicator comm, int block,
+                         FftPlanning planning = FftPlanning::Estimate);
   ~SlabFftHelmholtzSolver();
   SlabFftHelmholtzSolver(const SlabFftHelmholtzSolver&) = delete;
   SlabFftHelmholtzSolver& operator=(const SlabFftHelmholtzSolver&) = delete;
@@ -72,7 +74,7 @@ class SlabFftHelmholtzSolver {
 
  private:
   /// Plans with FFTW's default block (block = 0) or the given one.
-  void plan(const Grid& grid, int block);
+  void plan(const Grid& grid, int block, FftPlanning planning);
   /// Tabulates 1 / ((α + β Σλ) N) (0 for a zero denominator) for the local planes.
   void set_symbol(double alpha, double beta);
 

@@ -30,7 +30,8 @@ void project(const MacStencilGrid& g, const IndexBox& box, const Array3& us, con
 
 }  // namespace
 
-SlabNavierStokesSolver::SlabNavierStokesSolver(const Grid& grid, const FluidParams& params, Communicator comm)
+SlabNavierStokesSolver::SlabNavierStokesSolver(const Grid& grid, const FluidParams& params, Communicator comm,
+                                               FftPlanning planning)
     : grid_(grid),
       params_(params),
       slabs_(grid, comm),
@@ -59,7 +60,7 @@ SlabNavierStokesSolver::SlabNavierStokesSolver(const Grid& grid, const FluidPara
   }
   for (int l = 0; l < 4; ++l) {
     const Layout layout = static_cast<Layout>(l);
-    solvers_[l] = std::make_unique<SlabFftHelmholtzSolver>(grid_, layout, comm, slabs_.block());
+    solvers_[l] = std::make_unique<SlabFftHelmholtzSolver>(grid_, layout, comm, slabs_.block(), planning);
     const PlaneRange own = slabs_.owned(layout);
     if (solvers_[l]->first_array_plane() != own.begin || solvers_[l]->local_planes() != own.count())
       throw std::logic_error("SlabNavierStokesSolver: a fast solver's planes are not the decomposition's");

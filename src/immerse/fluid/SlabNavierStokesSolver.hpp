@@ -31,7 +31,7 @@
 //
 // The result equals the serial step's to round-off (the distributed transforms need not be planned like the serial
 // ones; on the test grids they give the same bits) and is bitwise the same on every run with the same number of
-// processes (FFTW_ESTIMATE plans, one thread per process, fixed message order). Construction, scatter/gather and
+// processes (FFTW_ESTIMATE plans by default, one thread per process, fixed message order). Construction, scatter/gather and
 // step() are collective over the communicator. No global state.
 // Verified by: the tests ParallelFluidStep.* (tests/test_parallel_fluid_step.cpp, run with 1, 2 and 3 processes: five
 // steps in a periodic box, between moving z walls and in a channel equal the serial steps within 1e-12, repeat
@@ -57,8 +57,10 @@ namespace immerse {
 class SlabNavierStokesSolver {
  public:
   /// Validates the parameters (InputError), refuses a cut that leaves a process without planes
-  /// (std::invalid_argument), and plans the four distributed solvers. Collective.
-  SlabNavierStokesSolver(const Grid& grid, const FluidParams& params, Communicator comm);
+  /// (std::invalid_argument), and plans the four distributed solvers (`planning`: as NavierStokesSolver's).
+  /// Collective.
+  SlabNavierStokesSolver(const Grid& grid, const FluidParams& params, Communicator comm,
+                         FftPlanning planning = FftPlanning::Estimate);
   SlabNavierStokesSolver(const SlabNavierStokesSolver&) = delete;  // its halo exchange refers to its decomposition
   SlabNavierStokesSolver& operator=(const SlabNavierStokesSolver&) = delete;
 

@@ -19,6 +19,7 @@
 #include "immerse/parallel/Agreement.hpp"
 #include "immerse/simulation/CheckpointEntries.hpp"
 #include "immerse/simulation/RunSetup.hpp"
+#include "immerse/simulation/StabilityCheck.hpp"
 
 namespace immerse {
 
@@ -31,10 +32,6 @@ const io::Config& distributable(const io::Config& config) {
                      "\"jfnk\", \"anderson\" or \"lbfgs\", or run in one process)");
   return config;
 }
-
-}  // namespace
-
-namespace {
 
 /// The stop query of every process agreed: true on all when it is true on any. Collective in each call.
 std::function<bool()> agreed(const Communicator& comm, const std::function<bool()>& stop_requested) {
@@ -50,7 +47,7 @@ DistributedSimulation::DistributedSimulation(const io::Config& config, Communica
       end_time_(config.get<double>("time.end")),
       max_speed_(config.get<double>("time.max_speed")),
       grid_(run_grid(config)),
-      fluid_(grid_, run_fluid_params(config), comm),
+      fluid_(grid_, run_fluid_params(config), comm, run_fft_planning(config)),
       coupler_(fluid_.decomposition(), delta_kernel(config.get<std::string>("coupling.kernel"))),
       membranes_(build_membrane_set(config, grid_, agreed(comm, stop_requested))),
       stepper_(config.get<double>("time.dt"), config.get<double>("time.dt_min")) {
@@ -190,46 +187,25 @@ void DistributedSimulation::correct_volumes() {
 }
 
 void DistributedSimulation::check_stability() const {
-  // As Simulation's check: every owned node's position and velocity finite and its speed |U| within time.max_speed,
-  // then the fluid velocity and pressure on this process's slab.
+  // Simulation's check on this process's part: its owned nodes, then the planes of the fluid it holds.
+  const StepPlace at{step_, time()};
   const auto X = op_->positions();
   const auto U = op_->node_velocity();
   const auto offsets = op_->membrane_offsets();
   std::string what;
-  for (std::size_t i = 0; i + 2 < X.size() && what.empty(); i += 3) {
-    const Vec3 x{X[i], X[i + 1], X[i + 2]}, u{U[i], U[i + 1], U[i + 2]};
-    if (isfinite(x) && isfinite(u) && norm(u) <= max_speed_) continue;
-    const auto k = static_cast<std::size_t>(std::upper_bound(offsets.begin(), offsets.end(), i) - offsets.begin()) - 1;
-    std::ostringstream s;
-    s.precision(10);
-    s << "unstable at step " << step_ << ", t = " << time() << ": membrane[" << op_->ownership().owned()[k].id
-      << "] node " << (i - offsets[k]) / 3 << " "
-      << (!isfinite(x)   ? "position is not finite"
-          : !isfinite(u) ? "velocity is not finite"
-                         : "speed exceeds time.max_speed (runaway)")
-      << " (|u| = " << norm(u) << " m/s, bound " << max_speed_ << " m/s)";
-    what = s.str();
+  for (std::size_t k = 0; k + 1 < offsets.size() && what.empty(); ++k)
+    for (std::size_t i = offsets[k]; i + 2 < offsets[k + 1] && what.empty(); i += 3)
+      what = node_instability(at, op_->ownership().owned()[k].id, (i - offsets[k]) / 3, {X[i], X[i + 1], X[i + 2]},
+                              {U[i], U[i + 1], U[i + 2]}, max_speed_);
+  const SlabDecomposition& slabs = fluid_.decomposition();
+  std::array<std::array<int, 2>, 4> planes{};
+  for (int l = 0; l < 4; ++l) {
+    const PlaneRange held = slabs.held(static_cast<Layout>(l));
+    planes[l] = {held.begin - slabs.offset(), held.end - slabs.offset()};
   }
-  const FluidState& f = op_->fluid_state();
-  for (int d = 0; d < 3 && what.empty(); ++d)
-    for (double v : f.u[d].values())
-      if (!(std::abs(v) <= max_speed_)) {
-        std::ostringstream s;
-        s.precision(10);
-        s << "unstable at step " << step_ << ", t = " << time() << ": fluid velocity u_" << "xyz"[d]
-          << " is not finite or exceeds time.max_speed (runaway)";
-        what = s.str();
-        break;
-      }
-  if (what.empty() && !std::ranges::all_of(f.p.values(), [](double v) { return std::isfinite(v); })) {
-    std::ostringstream s;
-    s.precision(10);
-    s << "unstable at step " << step_ << ", t = " << time() << ": fluid pressure is not finite";
-    what = s.str();
-  }
-  const Communicator& comm = fluid_.decomposition().communicator();
+  if (what.empty()) what = fluid_instability(at, op_->fluid_state(), planes, slabs.offset(), max_speed_);
   // Every process stops with the message of the lowest-ranked process that found the run unstable.
-  if (const std::string first = first_error(comm, what); !first.empty()) throw SimulationError(first);
+  if (const std::string first = first_error(slabs.communicator(), what); !first.empty()) throw SimulationError(first);
 }
 
 void DistributedSimulation::restore(const io::Checkpoint& ck) {

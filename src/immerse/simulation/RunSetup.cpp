@@ -40,6 +40,10 @@ Grid run_grid(const io::Config& c) {
               c.get<Vec3>("domain.origin"));
 }
 
+FftPlanning run_fft_planning(const io::Config& c) {
+  return c.get<std::string>("fluid.fft_planning") == "measure" ? FftPlanning::Measure : FftPlanning::Estimate;
+}
+
 FluidParams run_fluid_params(const io::Config& c) {
   FluidParams p;
   p.rho = c.get<double>("fluid.rho");

@@ -5,6 +5,7 @@
 // same way. The membranes are MembraneSet's.
 // Verified by: the tests of Simulation (test_simulation_*) and ParallelRun.* (the distributed run equals the
 // one-process run of the same configuration).
+#include "immerse/fluid/FftHelmholtzSolver.hpp"
 #include "immerse/fluid/FluidParams.hpp"
 #include "immerse/fluid/FluidState.hpp"
 #include "immerse/grid/Grid.hpp"
@@ -18,6 +19,8 @@ namespace immerse {
 Grid run_grid(const io::Config& config);
 /// fluid.* and the wall velocities; variable_viscosity when a membrane has viscosity_ratio ≠ 1.
 FluidParams run_fluid_params(const io::Config& config);
+/// fluid.fft_planning.
+FftPlanning run_fft_planning(const io::Config& config);
 /// contact.*.
 ContactSettings run_contact_settings(const io::Config& config);
 /// time.theta and solver.*.

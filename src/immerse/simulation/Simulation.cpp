@@ -13,13 +13,12 @@
 #include "immerse/simulation/MembraneSet.hpp"
 #include "immerse/simulation/RunSchema.hpp"
 #include "immerse/simulation/RunSetup.hpp"
+#include "immerse/simulation/StabilityCheck.hpp"
 #include "immerse/timestep/DenseBfgs.hpp"
 
 namespace immerse {
 
 namespace {
-
-const char* kAxes[3] = {"x", "y", "z"};
 
 std::string membrane_name(std::size_t m) { return "membrane[" + std::to_string(m) + "]"; }
 
@@ -31,8 +30,7 @@ Simulation::Simulation(const io::Config& config, const std::function<bool()>& st
       max_speed_(config.get<double>("time.max_speed")),
       grid_(run_grid(config)),
       threads_(ThreadGovernor::from_environment()),
-      fluid_(grid_, run_fluid_params(config),
-             config.get<std::string>("fluid.fft_planning") == "measure" ? FftPlanning::Measure : FftPlanning::Estimate),
+      fluid_(grid_, run_fluid_params(config), run_fft_planning(config)),
       coupler_(grid_, delta_kernel(config.get<std::string>("coupling.kernel"))),
       stepper_(config.get<double>("time.dt"), config.get<double>("time.dt_min")) {
   MembraneSet set = build_membrane_set(config_, grid_, stop_requested);
@@ -111,51 +109,19 @@ StepRecord Simulation::advance(const Log& log, const StopQuery& stop_requested) 
 }
 
 void Simulation::check_stability(const StepRecord& r) const {
-  const double vmax = max_speed_;
+  const StepPlace at{r.step, r.time};
   for (std::size_t m = 0; m < num_membranes(); ++m) {
     const auto X = op_->membrane_positions(m);
     const auto U = op_->membrane_velocities(m);
-    for (std::size_t i = 0; i < X.size(); ++i) {
-      const char* what = !isfinite(X[i]) ? "position is not finite"
-                         : !isfinite(U[i]) ? "velocity is not finite"
-                         : norm(U[i]) > vmax ? "speed exceeds time.max_speed (runaway)"
-                                             : nullptr;
-      if (!what) continue;
-      std::ostringstream s;
-      s.precision(10);
-      s << "unstable at step " << r.step << ", t = " << r.time << ": " << membrane_name(m) << " node " << i << " "
-        << what << " (|u| = " << norm(U[i]) << " m/s, bound " << vmax << ")";
-      throw SimulationError(s.str());
-    }
+    for (std::size_t i = 0; i < X.size(); ++i)
+      if (const auto what = node_instability(at, m, i, X[i], U[i], max_speed_); !what.empty())
+        throw SimulationError(what);
   }
   // The fluid everywhere in the box, also where no membrane samples it.
   const FluidState& f = op_->fluid_state();
-  auto unstable_at = [&](const Array3& a, std::size_t n, const std::string& what, const std::string& symbol,
-                         const char* where) {
-    const std::size_t i = n % std::size_t(a.nx()), j = n / std::size_t(a.nx()) % std::size_t(a.ny()),
-                      k = n / (std::size_t(a.nx()) * std::size_t(a.ny()));
-    std::ostringstream s;
-    s.precision(10);
-    s << "unstable at step " << r.step << ", t = " << r.time << ": fluid " << what << " at " << where << " (" << i
-      << ", " << j << ", " << k << ") ";
-    const double v = a.values()[n];
-    if (std::isfinite(v))
-      s << "exceeds time.max_speed (runaway) (|" << symbol << "| = " << std::abs(v) << " m/s, bound " << vmax << ")";
-    else
-      s << "is not finite";
-    throw SimulationError(s.str());
-  };
-  for (int d = 0; d < 3; ++d) {
-    const auto& u = f.u[d].values();
-    for (std::size_t n = 0; n < u.size(); ++n)
-      if (!(std::abs(u[n]) <= vmax)) {
-        const std::string u_d = std::string("u_") + kAxes[d];
-        unstable_at(f.u[d], n, "velocity " + u_d, u_d, "face");
-      }
-  }
-  const auto& p = f.p.values();
-  for (std::size_t n = 0; n < p.size(); ++n)
-    if (!std::isfinite(p[n])) unstable_at(f.p, n, "pressure", "p", "cell");
+  const std::array<std::array<int, 2>, 4> planes{
+      {{0, f.u[0].nz()}, {0, f.u[1].nz()}, {0, f.u[2].nz()}, {0, f.p.nz()}}};
+  if (const auto what = fluid_instability(at, f, planes, 0, max_speed_); !what.empty()) throw SimulationError(what);
 }
 
 io::Checkpoint Simulation::checkpoint() const {
