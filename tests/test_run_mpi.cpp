@@ -11,6 +11,7 @@
 #include <cstdio>
 #include <regex>
 
+#include "immerse/core/ThreadGovernor.hpp"
 #include "immerse/io/Checkpoint.hpp"
 #include "immerse/io/Hdf5.hpp"
 #include "test_run_support.hpp"
@@ -19,10 +20,12 @@ namespace immerse::testing {
 namespace {
 
 /// Starts `mpiexec -n NP immerse ARGS...` with the environment OpenMPI needs to start as root without a remote
-/// launcher; -q leaves the standard error to the program. Returns the pid of mpiexec.
-pid_t start_mpi(int np, const std::vector<std::string>& args, const fs::path& log_prefix) {
-  std::vector<std::string> argv_s{IMMERSE_MPIEXEC, "-q", "-n", std::to_string(np), "--oversubscribe",
-                                  immerse_program().string()};
+/// launcher; -q leaves the standard error to the program. One OpenMP thread per process, or with `governed` the
+/// processes unbound and OMP_NUM_THREADS unset (each process's thread governor chooses). Returns the pid of mpiexec.
+pid_t start_mpi(int np, const std::vector<std::string>& args, const fs::path& log_prefix, bool governed = false) {
+  std::vector<std::string> argv_s{IMMERSE_MPIEXEC, "-q", "-n", std::to_string(np), "--oversubscribe"};
+  if (governed) argv_s.insert(argv_s.end(), {"--bind-to", "none"});
+  argv_s.push_back(immerse_program().string());
   argv_s.insert(argv_s.end(), args.begin(), args.end());
   std::vector<char*> argv;
   for (auto& a : argv_s) argv.push_back(a.data());
@@ -37,6 +40,7 @@ pid_t start_mpi(int np, const std::vector<std::string>& args, const fs::path& lo
         }))
       env_s.push_back(v);
   }
+  if (governed) std::erase(env_s, std::string("OMP_NUM_THREADS=1"));
   std::vector<char*> envp;
   for (auto& v : env_s) envp.push_back(v.data());
   envp.push_back(nullptr);
@@ -61,8 +65,8 @@ RunResult wait_mpi(pid_t pid, const fs::path& log_prefix) {
 }
 
 /// `mpiexec -n NP immerse ARGS...` to its end.
-RunResult run_mpi(int np, const std::vector<std::string>& args, const fs::path& log_prefix) {
-  return wait_mpi(start_mpi(np, args, log_prefix), log_prefix);
+RunResult run_mpi(int np, const std::vector<std::string>& args, const fs::path& log_prefix, bool governed = false) {
+  return wait_mpi(start_mpi(np, args, log_prefix, governed), log_prefix);
 }
 
 /// The processes whose parent is `parent` (the ranks started by mpiexec).
@@ -607,6 +611,33 @@ TEST(RunMpi, GridBeyondTheMemoryOfAProcessIsRefused) {
       << r.err;
   EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
   EXPECT_FALSE(fs::exists(dir / "run"));
+}
+
+// Each process's thread governor: unbound processes without OMP_NUM_THREADS choose their thread count by
+// measurement (adaptive where a process has 2 CPUs or more, fixed at 1 otherwise), the summary says so, and the
+// run's checkpoint is bitwise that of one thread per process.
+TEST(RunMpi, EachProcessChoosesItsThreadsWithoutChangingTheResults) {
+  ScratchDir dir("run_mpi");
+  auto args = [&](const std::string& name) {
+    return run_args(scenario_file("rbc_channel_quick.toml"), dir / name,
+                    {"time.scheme=jfnk", "time.dt=2e-5", "time.end=1e-4", "output.fields_every=0"});
+  };
+  const auto governed = run_mpi(2, args("governed"), dir / "governed", true);
+  const auto one = run_mpi(2, args("one"), dir / "one");
+  ASSERT_EQ(governed.status, 0) << governed.err;
+  ASSERT_EQ(one.status, 0) << one.err;
+  const std::string policy = AvailableCpus::of_this_process().count() >= 2
+                                 ? R"(threads: 1 or \d+, chosen by measurement \([^)]*\): 1 thread for [0-9.]+ % of \d+ )"
+                                   R"(evaluations, \d+ for [0-9.]+ %, \d+ switch(es)? )"
+                                 : R"(threads: 1 \(fixed\) )";
+  EXPECT_TRUE(std::regex_search(
+      governed.out, std::regex(policy + R"(\(rank 0 of 2 MPI processes, each choosing its own\)\n)")))
+      << governed.out;
+  EXPECT_NE(one.out.find("threads: 1 (fixed by OMP_NUM_THREADS) (rank 0 of 2 MPI processes, each choosing its own)\n"),
+            std::string::npos)
+      << one.out;
+  EXPECT_EQ(io::Checkpoint::read(dir / "governed" / "checkpoint.h5").checksum(),
+            io::Checkpoint::read(dir / "one" / "checkpoint.h5").checksum());
 }
 
 }  // namespace

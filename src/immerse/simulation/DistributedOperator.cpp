@@ -263,6 +263,14 @@ void DistributedOperator::add_contact_forces(std::span<const Vec3> Xf) {
   }
 }
 
+template <class F>
+void DistributedOperator::governed(F&& evaluation) {
+  governor_.choose();
+  const auto t0 = std::chrono::steady_clock::now();
+  evaluation();
+  governor_.record(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+}
+
 void DistributedOperator::trial_step(std::span<const double> Xf, double theta, double dt) {
   trial_X_.clear();
   trial_done_ = false;
@@ -291,24 +299,30 @@ void DistributedOperator::trial_step(std::span<const double> Xf, double theta, d
 
 void DistributedOperator::trial_velocity(std::span<const double> Xf, double theta, std::span<const double> Xi,
                                          double dt, std::span<double> U) {
-  trial_step(Xf, theta, dt);
-  timed(timings_.interpolate, Phase::Interpolation, [&] { coupler_.interpolate_velocity(trial_.u, nodes(Xi), nodes(U)); });
+  governed([&] {
+    trial_step(Xf, theta, dt);
+    timed(timings_.interpolate, Phase::Interpolation,
+          [&] { coupler_.interpolate_velocity(trial_.u, nodes(Xi), nodes(U)); });
+  });
   trial_X_.assign(Xf.begin(), Xf.end());
   trial_done_ = true;
 }
 
 void DistributedOperator::trial_mean_velocity(std::span<const double> Xf, std::span<const double> Xi, double dt,
                                               std::span<double> U) {
-  trial_step(Xf, 1.0, dt);
-  // As ImmersedBoundaryOperator's blend with theta = 1/2, on every plane of the slabs.
-  mean_ = trial_.u;
-  for (int d = 0; d < 3; ++d) {
-    auto& o = mean_[d].values();
-    const auto& x = trial_.u[d].values();
-    const auto& y = committed_.u[d].values();
-    for (std::size_t i = 0; i < o.size(); ++i) o[i] = 0.5 * x[i] + 0.5 * y[i];
-  }
-  timed(timings_.interpolate, Phase::Interpolation, [&] { coupler_.interpolate_velocity(mean_, nodes(Xi), nodes(U)); });
+  governed([&] {
+    trial_step(Xf, 1.0, dt);
+    // As ImmersedBoundaryOperator's blend with theta = 1/2, on every plane of the slabs.
+    mean_ = trial_.u;
+    for (int d = 0; d < 3; ++d) {
+      auto& o = mean_[d].values();
+      const auto& x = trial_.u[d].values();
+      const auto& y = committed_.u[d].values();
+      for (std::size_t i = 0; i < o.size(); ++i) o[i] = 0.5 * x[i] + 0.5 * y[i];
+    }
+    timed(timings_.interpolate, Phase::Interpolation,
+          [&] { coupler_.interpolate_velocity(mean_, nodes(Xi), nodes(U)); });
+  });
   trial_X_.assign(Xf.begin(), Xf.end());
   trial_done_ = true;
 }

@@ -49,6 +49,7 @@
 #include <string>
 #include <vector>
 
+#include "immerse/core/ThreadGovernor.hpp"
 #include "immerse/core/Vec3.hpp"
 #include "immerse/coupling/SlabIBCoupler.hpp"
 #include "immerse/coupling/SlabViscosityIndicator.hpp"
@@ -101,6 +102,11 @@ class DistributedOperator final : public CoupledOperator {
   int migrations() const { return migrations_; }
   /// Wall time of this process in each part of the step so far.
   const StepTimings& timings() const { return timings_; }
+  /// The OpenMP threads of this process (membrane forces, contact, the fluid kernels, interpolation): each
+  /// evaluation of the residual runs with the count the governor chooses and reports its wall time to it, as in
+  /// ImmersedBoundaryOperator. Results do not depend on the count.
+  void set_thread_governor(const ThreadGovernor& g) { governor_ = g; }
+  const ThreadGovernor& thread_governor() const { return governor_; }
   /// χ of the last trial on this process's slab (empty without a viscosity contrast).
   const Array3& viscosity_indicator() const { return chi_; }
   /// Replaces the committed positions of the owned nodes by X (concatenated as positions()) after an accepted step:
@@ -123,6 +129,9 @@ class DistributedOperator final : public CoupledOperator {
   void add_contact_forces(std::span<const Vec3> Xf);
   /// Forces at Xf, spreading and the fluid step into trial_ driven by F^{n+1/2} of (Xf, theta). Collective.
   void trial_step(std::span<const double> Xf, double theta, double dt);
+  /// Runs one evaluation of the residual with the thread count the governor chooses, and reports its time.
+  template <class F>
+  void governed(F&& evaluation);
   /// The owned positions replaced by X, membranes migrated and U = J(X) u^n at the nodes owned then; no trial
   /// left. Collective.
   void move_to(std::span<const Vec3> X);
@@ -154,6 +163,7 @@ class DistributedOperator final : public CoupledOperator {
   std::size_t solves_ = 0;
   int migrations_ = 0;
   StepTimings timings_;
+  ThreadGovernor governor_;
 };
 
 }  // namespace immerse

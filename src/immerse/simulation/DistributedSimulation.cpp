@@ -47,6 +47,7 @@ DistributedSimulation::DistributedSimulation(const io::Config& config, Communica
       end_time_(config.get<double>("time.end")),
       max_speed_(config.get<double>("time.max_speed")),
       grid_(run_grid(config)),
+      threads_(ThreadGovernor::from_environment()),
       fluid_(grid_, run_fluid_params(config), comm, run_fft_planning(config)),
       coupler_(fluid_.decomposition(), delta_kernel(config.get<std::string>("coupling.kernel"))),
       membranes_(build_membrane_set(config, grid_, agreed(comm, stop_requested))),
@@ -57,6 +58,7 @@ DistributedSimulation::DistributedSimulation(const io::Config& config, Communica
       fluid_, coupler_, std::move(ms), membranes_.initial, membranes_.references,
       fluid_.scatter(run_initial_fluid_state(config_, grid_, fluid_.params())), run_contact_settings(config_),
       membranes_.viscosity_ratio);
+  op_->set_thread_governor(threads_);
   integrator_ = make_integrator(config_.get<std::string>("time.scheme"), run_solver_settings(config_),
                                 comm.comm());
   integrator_->prepare(op_->size());
@@ -270,6 +272,7 @@ void DistributedSimulation::restore(const io::Checkpoint& ck) {
   op_ = std::make_unique<DistributedOperator>(fluid_, coupler_, std::move(ms), X, membranes_.references,
                                               fluid_.scatter(f), run_contact_settings(config_),
                                               membranes_.viscosity_ratio);
+  op_->set_thread_governor(threads_);
   integrator_->prepare(op_->size());
   // The history of the nodes this process now owns, in its order (each stored vector: all unknowns, global order).
   const auto owned_part = [&](std::span<const double> global) {
@@ -547,10 +550,13 @@ std::string DistributedSimulation::decomposition_summary() const {
 }
 
 std::string DistributedSimulation::thread_policy() const {
-  return std::to_string(communicator().size()) + " MPI processes, each with the OpenMP threads OMP_NUM_THREADS gives it";
+  return op_->thread_governor().policy() + " on each of " + std::to_string(communicator().size()) + " MPI processes";
 }
 
-std::string DistributedSimulation::thread_summary() const { return "threads: " + thread_policy(); }
+std::string DistributedSimulation::thread_summary() const {
+  return op_->thread_governor().summary() + " (rank 0 of " + std::to_string(communicator().size()) +
+         " MPI processes, each choosing its own)";
+}
 
 void DistributedSimulation::set_applied_forces(std::size_t m, const std::vector<Vec3>& /*F*/) {
   throw InputError("membrane[" + std::to_string(m) + "]: applied nodal forces (scenario.kind = \"rbc_stretch\") are "

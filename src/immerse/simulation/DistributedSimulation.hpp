@@ -36,6 +36,7 @@
 #include "immerse/coupling/SlabIBCoupler.hpp"
 #include "immerse/fluid/FluidState.hpp"
 #include "immerse/fluid/SlabNavierStokesSolver.hpp"
+#include "immerse/core/ThreadGovernor.hpp"
 #include "immerse/grid/Grid.hpp"
 #include "immerse/io/Checkpoint.hpp"
 #include "immerse/io/Config.hpp"
@@ -143,6 +144,7 @@ class DistributedSimulation final : public SimulationInterface {
   io::Config config_;
   double end_time_, max_speed_;
   Grid grid_;
+  ThreadGovernor threads_;  ///< this process's OpenMP threads (its CPUs: the launcher's binding, the cgroup quota)
   SlabNavierStokesSolver fluid_;
   SlabIBCoupler coupler_;
   MembraneSet membranes_;
