@@ -8,7 +8,7 @@
 #include <filesystem>
 #include <iostream>
 
-#include "immerse/app/RunCommand.hpp"
+#include "immerse/cli/RunCommand.hpp"
 #include "immerse/core/Error.hpp"
 #include "immerse/io/Provenance.hpp"
 #include "immerse/timestep/PetscSession.hpp"
@@ -66,7 +66,7 @@ int main(int argc, char** argv) {
   app.set_version_flag("--version", std::string("immerse ") + IMMERSE_VERSION);
   app.require_subcommand(1);
 
-  immerse::RunOptions run_opts;
+  immerse::CommandLine run_opts;
   bool help_config = false;
   auto* run = app.add_subcommand("run", "Run the experiment described by a TOML file");
   run->add_option("file", run_opts.file, "Configuration (e.g. scenarios/capsule_shear_quick.toml)");

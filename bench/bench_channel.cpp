@@ -46,9 +46,9 @@
 #include <string>
 #include <vector>
 
-#include "immerse/app/Scenario.hpp"
 #include "immerse/core/Error.hpp"
-#include "immerse/simulation/RunSchema.hpp"
+#include "immerse/scenario/Scenario.hpp"
+#include "immerse/simulation/Parameters.hpp"
 #include "immerse/simulation/Simulation.hpp"
 #include "immerse/timestep/PetscSession.hpp"
 

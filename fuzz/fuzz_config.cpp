@@ -9,10 +9,10 @@
 #include <cstring>
 #include <string_view>
 
-#include "immerse/app/Scenario.hpp"
 #include "immerse/core/Error.hpp"
 #include "immerse/io/Config.hpp"
-#include "immerse/simulation/RunSchema.hpp"
+#include "immerse/scenario/Scenario.hpp"
+#include "immerse/simulation/Parameters.hpp"
 
 namespace {
 

@@ -16,12 +16,12 @@
 #include <string>
 #include <vector>
 
-#include "immerse/app/Diagnostics.hpp"
-#include "immerse/app/Scenario.hpp"
-#include "immerse/app/ScenarioRun.hpp"
 #include "immerse/core/Error.hpp"
 #include "immerse/io/Config.hpp"
-#include "immerse/simulation/RunSchema.hpp"
+#include "immerse/run/Diagnostics.hpp"
+#include "immerse/scenario/Scenario.hpp"
+#include "immerse/scenario/ScenarioRun.hpp"
+#include "immerse/simulation/Parameters.hpp"
 #include "immerse/simulation/Simulation.hpp"
 #include "immerse/timestep/PetscSession.hpp"
 

@@ -7,13 +7,13 @@
 #include <cmath>
 #include <fstream>
 
+#include "immerse/contact/CellPacking.hpp"
+#include "immerse/contact/MembraneClearance.hpp"
 #include "immerse/core/Error.hpp"
 #include "immerse/io/Checkpoint.hpp"
 #include "immerse/membrane/Geometry.hpp"
 #include "immerse/membrane/MeshGenerator.hpp"
 #include "immerse/membrane/Shape.hpp"
-#include "immerse/simulation/CellPacking.hpp"
-#include "immerse/simulation/MembraneClearance.hpp"
 #include "test_run_support.hpp"
 
 using namespace immerse;

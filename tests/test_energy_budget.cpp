@@ -20,7 +20,7 @@
 #include <vector>
 
 #include "PetscEnvironment.hpp"
-#include "immerse/app/RunCommand.hpp"
+#include "immerse/cli/RunCommand.hpp"
 #include "immerse/fluid/ExactSolutions.hpp"
 #include "immerse/fluid/FluidDiagnostics.hpp"
 #include "immerse/fluid/FluidEnergy.hpp"
@@ -294,7 +294,7 @@ Table read_table(const fs::path& path) {
 int run_capsule(const fs::path& out, const std::vector<std::string>& sets, const fs::path& restart = {},
                 std::string* log = nullptr) {
   std::ostringstream out_log, err;
-  RunOptions o;
+  CommandLine o;
   o.file = scenario_file("oscillating_membrane_quick.toml");
   o.sets = sets;
   o.out = out;

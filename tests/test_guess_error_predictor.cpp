@@ -15,9 +15,9 @@
 
 #include "PetscEnvironment.hpp"
 #include "ToyOperator.hpp"
-#include "immerse/app/Scenario.hpp"
 #include "immerse/core/Error.hpp"
-#include "immerse/simulation/RunSchema.hpp"
+#include "immerse/scenario/Scenario.hpp"
+#include "immerse/simulation/Parameters.hpp"
 #include "immerse/simulation/Simulation.hpp"
 #include "immerse/timestep/GuessErrorPredictor.hpp"
 #include "immerse/verify/OscillatingMembrane.hpp"

@@ -13,7 +13,7 @@
 #include <vector>
 
 #include "PetscEnvironment.hpp"
-#include "immerse/app/RunCommand.hpp"
+#include "immerse/cli/RunCommand.hpp"
 #include "test_run_support.hpp"
 
 using namespace immerse;
@@ -38,7 +38,7 @@ std::vector<Row> read_rows(const fs::path& csv) {
 int run_at_rest(const fs::path& out, std::vector<std::string> sets) {
   sets.push_back("membrane[0].force=\"energy\"");
   std::ostringstream log, err;
-  RunOptions o;
+  CommandLine o;
   o.file = scenario_file("oscillating_membrane_quick.toml");
   o.sets = std::move(sets);
   o.out = out;

@@ -22,15 +22,15 @@
 
 #include "MpiEnvironment.hpp"  // first: MPI starts before PETSc and ends after it
 #include "PetscEnvironment.hpp"
-#include "immerse/app/Scenario.hpp"
+#include "immerse/contact/ContactForce.hpp"
 #include "immerse/core/Error.hpp"
-#include "immerse/parallel/Communicator.hpp"
-#include "immerse/simulation/ContactForce.hpp"
 #include "immerse/membrane/VolumeAreaConstraint.hpp"
+#include "immerse/parallel/Communicator.hpp"
+#include "immerse/scenario/Scenario.hpp"
+#include "immerse/simulation/ConfigSetup.hpp"
 #include "immerse/simulation/DistributedSimulation.hpp"
 #include "immerse/simulation/MembraneSet.hpp"
-#include "immerse/simulation/RunSchema.hpp"
-#include "immerse/simulation/RunSetup.hpp"
+#include "immerse/simulation/Parameters.hpp"
 #include "immerse/simulation/Simulation.hpp"
 #include "immerse/timestep/GuessErrorPredictor.hpp"
 

@@ -10,11 +10,11 @@
 #include <typeinfo>
 #include <vector>
 
-#include "immerse/app/Scenario.hpp"
 #include "immerse/core/Error.hpp"
 #include "immerse/io/Config.hpp"
 #include "immerse/membrane/GmshReader.hpp"
-#include "immerse/simulation/RunSchema.hpp"
+#include "immerse/scenario/Scenario.hpp"
+#include "immerse/simulation/Parameters.hpp"
 
 using namespace immerse;
 namespace fs = std::filesystem;

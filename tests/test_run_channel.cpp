@@ -5,10 +5,10 @@
 
 #include <cmath>
 
-#include "immerse/app/Scenario.hpp"
 #include "immerse/fluid/ExactSolutions.hpp"
 #include "immerse/io/ConfigSchema.hpp"
-#include "immerse/simulation/RunSchema.hpp"
+#include "immerse/scenario/Scenario.hpp"
+#include "immerse/simulation/Parameters.hpp"
 #include "test_run_support.hpp"
 
 using namespace immerse;

@@ -7,11 +7,11 @@
 #include <sstream>
 
 #include "PetscEnvironment.hpp"
-#include "immerse/app/RunCommand.hpp"
-#include "immerse/app/Scenario.hpp"
+#include "immerse/cli/RunCommand.hpp"
 #include "immerse/io/Checkpoint.hpp"
 #include "immerse/io/Hdf5.hpp"
-#include "immerse/simulation/RunSchema.hpp"
+#include "immerse/scenario/Scenario.hpp"
+#include "immerse/simulation/Parameters.hpp"
 #include "test_run_support.hpp"
 
 using namespace immerse;
@@ -34,7 +34,7 @@ class RunOutputTest : public ::testing::Test {
     EXPECT_EQ(err.str(), "");
   }
   ScratchDir dir_{"output"};
-  RunOptions options_;
+  CommandLine options_;
   std::ostringstream log_;
 };
 
@@ -56,7 +56,7 @@ TEST_F(RunOutputTest, ResolvedConfigurationReparsesToTheConfigurationThatRan) {
 // --verbose prints the whole resolved configuration as well.
 TEST(RunOutputVerbose, PrintsTheResolvedConfiguration) {
   ScratchDir dir("output");
-  RunOptions o;
+  CommandLine o;
   o.file = scenario_file("oscillating_membrane_quick.toml");
   o.sets = small_membrane_sets(1);
   o.out = dir / "out";
@@ -167,13 +167,13 @@ TEST_F(RunOutputTest, EndsWithTheProfileAndAFullPrecisionSummary) {
   EXPECT_NEAR(printed, saved, 1e-5 * std::abs(saved));
 }
 
-TEST(RunOutput, WithoutFieldsNoParaViewFilesAndAPrefixPerMembrane) {
+TEST(OutputWriter, WithoutFieldsNoParaViewFilesAndAPrefixPerMembrane) {
   // Two membranes side by side: the membrane columns are repeated with prefixes m0_, m1_.
   ScratchDir dir("output_two");
   const std::string base = read_text(scenario_file("oscillating_membrane_quick.toml"));
   const fs::path file = dir / "two.toml";
   std::ofstream(file) << base << "\n" << base.substr(base.find("[[membrane]]"));
-  RunOptions o;
+  CommandLine o;
   o.file = file;
   o.sets = small_membrane_sets(2);
   for (const char* s : {"domain.Lx=2.0", "grid.nx=32", "membrane[0].center=[0.5,0.5,0.5]",

@@ -13,10 +13,10 @@
 #include <string>
 #include <vector>
 
-#include "immerse/app/Scenario.hpp"
+#include "immerse/contact/MembraneClearance.hpp"
 #include "immerse/membrane/Geometry.hpp"
-#include "immerse/simulation/MembraneClearance.hpp"
-#include "immerse/simulation/RunSchema.hpp"
+#include "immerse/scenario/Scenario.hpp"
+#include "immerse/simulation/Parameters.hpp"
 #include "immerse/simulation/Simulation.hpp"
 #include "PetscEnvironment.hpp"
 #include "test_run_support.hpp"

@@ -11,9 +11,9 @@
 #include <string>
 #include <vector>
 
-#include "immerse/app/Scenario.hpp"
 #include "immerse/membrane/Geometry.hpp"
-#include "immerse/simulation/RunSchema.hpp"
+#include "immerse/scenario/Scenario.hpp"
+#include "immerse/simulation/Parameters.hpp"
 #include "immerse/simulation/Simulation.hpp"
 #include "PetscEnvironment.hpp"
 #include "test_run_support.hpp"

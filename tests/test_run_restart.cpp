@@ -6,7 +6,7 @@
 #include <sstream>
 
 #include "PetscEnvironment.hpp"
-#include "immerse/app/RunCommand.hpp"
+#include "immerse/cli/RunCommand.hpp"
 #include "immerse/io/Checkpoint.hpp"
 #include "test_run_support.hpp"
 
@@ -19,7 +19,7 @@ constexpr int kSteps = 8;
 
 int run(const fs::path& out, std::vector<std::string> sets, const fs::path& restart = {}) {
   std::ostringstream log, err;
-  RunOptions o;
+  CommandLine o;
   o.file = scenario_file("oscillating_membrane_quick.toml");
   o.sets = std::move(sets);
   o.out = out;
@@ -100,7 +100,7 @@ TEST(RestartSweep, ForceSweepContinuesBitwiseFromAMidSweepCheckpoint) {
   };
   auto run_sweep = [&](const fs::path& out, const std::string& end, const fs::path& restart = {}) {
     std::ostringstream log, err;
-    RunOptions o;
+    CommandLine o;
     o.file = scenario_file("rbc_stretch_quick.toml");
     o.sets = sets(end);
     o.out = out;

@@ -1,4 +1,4 @@
-// scenario.kind = "suspension_shear" (src/immerse/app/SuspensionShearRun.hpp): the relative viscosity of plane
+// scenario.kind = "suspension_shear" (src/immerse/scenario/SuspensionShearRun.hpp): the relative viscosity of plane
 // Couette flow from the wall stress, exactly 1 without cells; red cells packed at a few per cent raise it and keep
 // their volume; the kind's one-line refusals of walls that do not shear.
 #include <gtest/gtest.h>
@@ -7,11 +7,11 @@
 #include <string>
 #include <vector>
 
-#include "immerse/app/Scenario.hpp"
-#include "immerse/app/SuspensionShearRun.hpp"
 #include "immerse/core/Error.hpp"
 #include "immerse/membrane/Geometry.hpp"
-#include "immerse/simulation/RunSchema.hpp"
+#include "immerse/scenario/Scenario.hpp"
+#include "immerse/scenario/SuspensionShearRun.hpp"
+#include "immerse/simulation/Parameters.hpp"
 #include "immerse/simulation/Simulation.hpp"
 #include "PetscEnvironment.hpp"
 #include "test_run_support.hpp"

@@ -17,10 +17,10 @@
 #pragma GCC diagnostic pop
 
 #include "PetscEnvironment.hpp"
-#include "immerse/app/Scenario.hpp"
 #include "immerse/io/Checkpoint.hpp"
 #include "immerse/membrane/Geometry.hpp"
-#include "immerse/simulation/RunSchema.hpp"
+#include "immerse/scenario/Scenario.hpp"
+#include "immerse/simulation/Parameters.hpp"
 #include "immerse/simulation/Simulation.hpp"
 #include "test_run_support.hpp"
 

@@ -8,9 +8,9 @@
 #include <string>
 #include <vector>
 
-#include "immerse/app/Scenario.hpp"
 #include "immerse/core/Error.hpp"
-#include "immerse/simulation/RunSchema.hpp"
+#include "immerse/scenario/Scenario.hpp"
+#include "immerse/simulation/Parameters.hpp"
 
 using namespace immerse;
 

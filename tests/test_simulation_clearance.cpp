@@ -7,8 +7,8 @@
 #include <cmath>
 #include <random>
 
+#include "immerse/contact/MembraneClearance.hpp"
 #include "immerse/membrane/MeshGenerator.hpp"
-#include "immerse/simulation/MembraneClearance.hpp"
 
 using namespace immerse;
 

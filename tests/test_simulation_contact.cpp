@@ -8,11 +8,11 @@
 #include <cmath>
 #include <random>
 
-#include "immerse/app/Scenario.hpp"
+#include "immerse/contact/ContactForce.hpp"
+#include "immerse/contact/MembraneClearance.hpp"
 #include "immerse/io/ConfigSchema.hpp"
-#include "immerse/simulation/ContactForce.hpp"
-#include "immerse/simulation/MembraneClearance.hpp"
-#include "immerse/simulation/RunSchema.hpp"
+#include "immerse/scenario/Scenario.hpp"
+#include "immerse/simulation/Parameters.hpp"
 #include "immerse/simulation/Simulation.hpp"
 #include "PetscEnvironment.hpp"
 #include "test_run_support.hpp"

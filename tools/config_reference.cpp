@@ -10,7 +10,7 @@
 
 #include "immerse/io/ConfigSchema.hpp"
 #include "immerse/io/TomlFormat.hpp"
-#include "immerse/simulation/RunSchema.hpp"
+#include "immerse/simulation/Parameters.hpp"
 
 namespace {
 

@@ -4,9 +4,9 @@
 #include <iostream>
 #include <string>
 
-#include "immerse/app/Scenario.hpp"
 #include "immerse/membrane/Geometry.hpp"
-#include "immerse/simulation/RunSchema.hpp"
+#include "immerse/scenario/Scenario.hpp"
+#include "immerse/simulation/Parameters.hpp"
 #include "immerse/simulation/Simulation.hpp"
 #include "immerse/timestep/PetscSession.hpp"
 

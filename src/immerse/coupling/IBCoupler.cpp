@@ -5,9 +5,9 @@
 #include <stdexcept>
 #include <string>
 
+#include "immerse/core/ThreadThresholds.hpp"
 #include "immerse/coupling/IBStencil_K.hpp"
 #include "immerse/coupling/NodeDiagnostics.hpp"
-#include "immerse/core/Parallel.hpp"
 
 namespace immerse {
 

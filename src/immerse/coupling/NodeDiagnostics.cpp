@@ -5,7 +5,7 @@
 #include <sstream>
 
 #include "immerse/core/Error.hpp"
-#include "immerse/core/Parallel.hpp"
+#include "immerse/core/ThreadThresholds.hpp"
 
 namespace immerse {
 

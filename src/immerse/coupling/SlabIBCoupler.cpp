@@ -11,7 +11,7 @@
 #include <type_traits>
 #include <variant>
 
-#include "immerse/core/Parallel.hpp"
+#include "immerse/core/ThreadThresholds.hpp"
 #include "immerse/coupling/IBStencil_K.hpp"
 #include "immerse/coupling/NodeDiagnostics.hpp"
 

@@ -8,7 +8,7 @@
 #include <algorithm>
 #include <array>
 
-#include "immerse/core/Parallel.hpp"
+#include "immerse/core/ThreadThresholds.hpp"
 #include "immerse/core/Vec3.hpp"
 #include "immerse/fluid/FluidParams.hpp"
 #include "immerse/grid/Grid.hpp"

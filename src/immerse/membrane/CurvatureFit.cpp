@@ -7,8 +7,8 @@
 
 #include "immerse/core/Cholesky_K.hpp"
 #include "immerse/core/Error.hpp"
+#include "immerse/core/ThreadThresholds.hpp"
 #include "immerse/membrane/BalancedRange.hpp"
-#include "immerse/core/Parallel.hpp"
 
 namespace immerse {
 

@@ -8,11 +8,11 @@
 
 #include "immerse/core/Error.hpp"
 #include "immerse/core/Mat3.hpp"
+#include "immerse/core/ThreadThresholds.hpp"
 #include "immerse/membrane/BalancedRange.hpp"
 #include "immerse/membrane/Geometry.hpp"
 #include "immerse/membrane/MembraneKinematics_K.hpp"
 #include "immerse/membrane/QuadraticTriangle_K.hpp"
-#include "immerse/core/Parallel.hpp"
 
 namespace immerse {
 

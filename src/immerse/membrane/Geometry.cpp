@@ -4,8 +4,8 @@
 #include <cmath>
 #include <limits>
 
+#include "immerse/core/ThreadThresholds.hpp"
 #include "immerse/membrane/MeshElement.hpp"
-#include "immerse/core/Parallel.hpp"
 
 namespace immerse {
 namespace {

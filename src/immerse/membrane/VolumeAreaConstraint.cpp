@@ -3,7 +3,7 @@
 #include <cmath>
 
 #include "immerse/core/Error.hpp"
-#include "immerse/core/Parallel.hpp"
+#include "immerse/core/ThreadThresholds.hpp"
 #include "immerse/membrane/Geometry.hpp"
 #include "immerse/membrane/MeshElement.hpp"
 

@@ -5,7 +5,7 @@
 #include <sstream>
 
 #include "immerse/core/Error.hpp"
-#include "immerse/simulation/RunSchema.hpp"
+#include "immerse/simulation/Parameters.hpp"
 
 namespace immerse {
 

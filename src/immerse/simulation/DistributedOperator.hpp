@@ -49,6 +49,7 @@
 #include <string>
 #include <vector>
 
+#include "immerse/contact/ContactForce.hpp"
 #include "immerse/core/ThreadGovernor.hpp"
 #include "immerse/core/Vec3.hpp"
 #include "immerse/coupling/SlabIBCoupler.hpp"
@@ -58,7 +59,6 @@
 #include "immerse/grid/FaceField.hpp"
 #include "immerse/membrane/ElasticMembrane.hpp"
 #include "immerse/parallel/MembraneOwnership.hpp"
-#include "immerse/simulation/ContactForce.hpp"
 #include "immerse/simulation/StepTimings.hpp"
 #include "immerse/timestep/CoupledOperator.hpp"
 

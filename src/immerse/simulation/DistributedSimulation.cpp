@@ -18,7 +18,7 @@
 #include "immerse/membrane/VolumeCorrection.hpp"
 #include "immerse/parallel/Agreement.hpp"
 #include "immerse/simulation/CheckpointEntries.hpp"
-#include "immerse/simulation/RunSetup.hpp"
+#include "immerse/simulation/ConfigSetup.hpp"
 #include "immerse/simulation/StabilityCheck.hpp"
 
 namespace immerse {

@@ -2,7 +2,7 @@
 // One run distributed over the MPI processes of a communicator: the grid cut into slabs of z planes
 // (SlabNavierStokesSolver, SlabIBCoupler), each membrane advanced by the process owning it (DistributedOperator,
 // MembraneOwnership), built from the same resolved configuration as Simulation with the same code (run_grid,
-// run_fluid_params, run_contact_settings, run_initial_fluid_state of RunSetup.hpp; the membranes, packing included,
+// run_fluid_params, run_contact_settings, run_initial_fluid_state of ConfigSetup.hpp; the membranes, packing included,
 // of build_membrane_set): every process builds all membranes (meshes, reference positions, force objects) and keeps
 // the ones it owns as its unknowns.
 //
@@ -32,11 +32,11 @@
 #include <string>
 #include <vector>
 
+#include "immerse/core/ThreadGovernor.hpp"
 #include "immerse/core/Vec3.hpp"
 #include "immerse/coupling/SlabIBCoupler.hpp"
 #include "immerse/fluid/FluidState.hpp"
 #include "immerse/fluid/SlabNavierStokesSolver.hpp"
-#include "immerse/core/ThreadGovernor.hpp"
 #include "immerse/grid/Grid.hpp"
 #include "immerse/io/Checkpoint.hpp"
 #include "immerse/io/Config.hpp"

@@ -11,9 +11,9 @@
 #include <utility>
 
 #include "immerse/core/Error.hpp"
-#include "immerse/core/Parallel.hpp"
-#include "immerse/fluid/MacStencilGrid.hpp"
+#include "immerse/core/ThreadThresholds.hpp"
 #include "immerse/coupling/NodeDiagnostics.hpp"
+#include "immerse/fluid/MacStencilGrid.hpp"
 #include "immerse/simulation/InversionReport.hpp"
 #include "immerse/timestep/LogEvent.hpp"
 

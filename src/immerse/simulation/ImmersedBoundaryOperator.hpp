@@ -27,12 +27,12 @@
 #include <span>
 #include <vector>
 
+#include "immerse/contact/ContactForce.hpp"
 #include "immerse/core/ThreadGovernor.hpp"
 #include "immerse/coupling/IBCoupler.hpp"
 #include "immerse/coupling/ViscosityIndicator.hpp"
 #include "immerse/fluid/NavierStokesSolver.hpp"
 #include "immerse/membrane/ElasticMembrane.hpp"
-#include "immerse/simulation/ContactForce.hpp"
 #include "immerse/simulation/StepTimings.hpp"
 #include "immerse/timestep/CoupledOperator.hpp"
 

@@ -5,6 +5,8 @@
 #include <cmath>
 #include <sstream>
 
+#include "immerse/contact/CellPacking.hpp"
+#include "immerse/contact/MembraneClearance.hpp"
 #include "immerse/core/Error.hpp"
 #include "immerse/coupling/NodeDiagnostics.hpp"
 #include "immerse/io/TomlFormat.hpp"
@@ -16,8 +18,6 @@
 #include "immerse/membrane/Shape.hpp"
 #include "immerse/membrane/Skalak.hpp"
 #include "immerse/membrane/Yeoh.hpp"
-#include "immerse/simulation/CellPacking.hpp"
-#include "immerse/simulation/MembraneClearance.hpp"
 
 namespace immerse {
 

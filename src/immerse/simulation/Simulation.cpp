@@ -10,9 +10,9 @@
 #include "immerse/fluid/FluidDiagnostics.hpp"
 #include "immerse/membrane/VolumeCorrection.hpp"
 #include "immerse/simulation/CheckpointEntries.hpp"
+#include "immerse/simulation/ConfigSetup.hpp"
 #include "immerse/simulation/MembraneSet.hpp"
-#include "immerse/simulation/RunSchema.hpp"
-#include "immerse/simulation/RunSetup.hpp"
+#include "immerse/simulation/Parameters.hpp"
 #include "immerse/simulation/StabilityCheck.hpp"
 #include "immerse/timestep/DenseBfgs.hpp"
 

@@ -1,6 +1,6 @@
 #pragma once
 // One run in one process: the grid, the fluid, the membranes, their coupling and the time integrator, built from a
-// resolved configuration (RunSchema), advanced step by step. run_command (app/RunCommand.hpp) schedules callbacks
+// resolved configuration (Parameters), advanced step by step. run_command (cli/RunCommand.hpp) schedules callbacks
 // (diagnostics, ParaView frames, checkpoints, progress) around advance() through SimulationInterface, which it
 // implements with no MPI call.
 #include <functional>

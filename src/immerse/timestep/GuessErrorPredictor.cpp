@@ -6,7 +6,7 @@
 
 #include "immerse/core/Cholesky_K.hpp"
 #include "immerse/core/Error.hpp"
-#include "immerse/core/Parallel.hpp"
+#include "immerse/core/ThreadThresholds.hpp"
 
 namespace immerse {
 

@@ -1,5 +1,5 @@
+#include "immerse/core/ThreadThresholds.hpp"
 #include "immerse/timestep/MembraneIntegrator.hpp"
-#include "immerse/core/Parallel.hpp"
 
 #include <cmath>
 

@@ -1,5 +1,5 @@
+#include "immerse/core/ThreadThresholds.hpp"
 #include "immerse/timestep/SnesIntegrator.hpp"
-#include "immerse/core/Parallel.hpp"
 
 #include <cmath>
 #include <cstdlib>

@@ -14,8 +14,8 @@
 #include <span>
 #include <vector>
 
+#include "immerse/core/ThreadThresholds.hpp"
 #include "immerse/timestep/CoupledOperator.hpp"
-#include "immerse/core/Parallel.hpp"
 
 namespace immerse {
 

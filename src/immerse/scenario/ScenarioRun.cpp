@@ -1,0 +1,17 @@
+#include "immerse/scenario/ScenarioRun.hpp"
+
+#include "immerse/scenario/ChannelRun.hpp"
+#include "immerse/scenario/StretchSweepRun.hpp"
+#include "immerse/scenario/SuspensionShearRun.hpp"
+
+namespace immerse {
+
+std::unique_ptr<ScenarioRun> make_scenario_run(const io::Config& config) {
+  const std::string kind = config.get<std::string>("scenario.kind");
+  if (kind == "rbc_stretch") return std::make_unique<StretchSweepRun>();
+  if (kind == "rbc_channel") return std::make_unique<ChannelRun>();
+  if (kind == "suspension_shear") return std::make_unique<SuspensionShearRun>(config);
+  return std::make_unique<ScenarioRun>();
+}
+
+}  // namespace immerse
