@@ -7,6 +7,7 @@
 #include <cerrno>
 #include <cmath>
 #include <cstring>
+#include <map>
 #include <ostream>
 #include <sstream>
 #include <stdexcept>
@@ -377,6 +378,21 @@ class ConfigResolver {
     if (given) target->given_.insert(rel);
   }
 
+  // set() writes its value only once it is valid, but for a table array's new entry it adds the entry first: that
+  // entry is removed again when the assignment fails, so one assignment either applies or leaves cfg as it was.
+  static void set_or_leave(const ConfigSchema& s, Config& cfg, const std::string& assignment, bool given) {
+    std::map<std::string, std::size_t> sizes;
+    for (const auto& [name, entries] : cfg.tables_) sizes[name] = entries.size();
+    try {
+      set(s, cfg, assignment, given);
+    } catch (...) {
+      std::erase_if(cfg.tables_, [&](const auto& t) { return !sizes.contains(t.first); });
+      for (auto& [name, entries] : cfg.tables_)
+        entries.erase(entries.begin() + static_cast<std::ptrdiff_t>(sizes[name]), entries.end());
+      throw;
+    }
+  }
+
   static void check_counts(const ConfigSchema& s, const Config& cfg, const std::string& origin) {
     for (const auto& a : s.table_arrays()) {
       const std::size_t n = cfg.count(a.name);
@@ -396,6 +412,8 @@ void ConfigSchema::apply_overrides(Config& config, std::span<const std::string> 
 }
 
 void ConfigSchema::apply_derived(Config& config, std::span<const std::string> assignments) const {
+  // One assignment (Config::derive, once per derived key: a copy each time would make deriving N cells O(N^2)).
+  if (assignments.size() == 1) return ConfigResolver::set_or_leave(*this, config, assignments[0], false);
   Config updated = config;
   for (const auto& a : assignments) ConfigResolver::set(*this, updated, a, false);
   config = std::move(updated);
