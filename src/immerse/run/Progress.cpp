@@ -17,7 +17,11 @@ Progress::Progress(std::ostream& out, double end, double log_seconds)
     : out_(out), end_(end), every_(log_seconds), tty_(isatty(STDOUT_FILENO)), t0_(clock::now()), last_(t0_) {}
 
 void Progress::update(const SimulationInterface& sim, long steps_done) {
-  const double wall = sim.min_wall_distance();  // on every process, at every step: a collective call
+  // In one process only when the line is printed; over several at every step on every process (a collective call,
+  // and only rank 0 decides whether to print).
+  if (sim.communicator().size() == 1)
+    return update(sim.time(), sim.step(), [&sim] { return sim.min_wall_distance(); }, steps_done);
+  const double wall = sim.min_wall_distance();
   update(sim.time(), sim.step(), [wall] { return wall; }, steps_done);
 }
 
