@@ -13,15 +13,14 @@ namespace {
 
 /// Empty string when node x is inside, else the reason.
 std::string outside_reason(const Grid& g, const Vec3& x) {
-  static const char* names[3] = {"x", "y", "z"};
   if (!isfinite(x)) return "non-finite position";
   for (int a = 0; a < 3; ++a) {
     if (g.periodic(a)) continue;
     const double lo = g.origin()[a], hi = lo + g.length(a);
     std::ostringstream s;
     s.precision(10);
-    if (x[a] < lo) s << "beyond the wall " << names[a] << " = " << lo;
-    if (x[a] > hi) s << "beyond the wall " << names[a] << " = " << hi;
+    if (x[a] < lo) s << "beyond the wall " << axis_name(a) << " = " << lo;
+    if (x[a] > hi) s << "beyond the wall " << axis_name(a) << " = " << hi;
     if (!s.str().empty()) return s.str();
   }
   return {};

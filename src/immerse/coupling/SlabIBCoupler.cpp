@@ -19,10 +19,6 @@ namespace immerse {
 
 namespace {
 
-void check(int code, const char* what) {
-  if (code != MPI_SUCCESS) throw std::runtime_error(std::string("MPI error in ") + what);
-}
-
 /// The line stencils of a node: along x and y those of the whole grid (IBCoupler's), along z those of the padded
 /// buffers, whose plane 0 is the global plane begin_c (centres, components 0 and 1) or begin_f (faces, component 2)
 /// and into which the node's z image is shifted by `shift` planes.
@@ -107,7 +103,7 @@ void SlabIBCoupler::gather_ranges() {
     mine[2 * d + 1] = range_[d].end;
   }
   std::vector<int> all(static_cast<std::size_t>(6) * size_);
-  check(MPI_Allgather(mine, 6, MPI_INT, all.data(), 6, MPI_INT, slabs_.communicator().comm()), "MPI_Allgather");
+  check_mpi(MPI_Allgather(mine, 6, MPI_INT, all.data(), 6, MPI_INT, slabs_.communicator().comm()), "MPI_Allgather");
   for (std::size_t q = 0; q < all_ranges_.size(); ++q) all_ranges_[q] = {all[2 * q], all[2 * q + 1]};
 }
 
@@ -144,7 +140,7 @@ SlabIBCoupler::Exchange SlabIBCoupler::plan_exchange(bool spreading) {
 }
 
 void SlabIBCoupler::exchange(const Exchange& e) {
-  check(MPI_Alltoallv(send_.data(), e.send_counts.data(), e.send_offsets.data(), MPI_DOUBLE, recv_.data(),
+  check_mpi(MPI_Alltoallv(send_.data(), e.send_counts.data(), e.send_offsets.data(), MPI_DOUBLE, recv_.data(),
                       e.recv_counts.data(), e.recv_offsets.data(), MPI_DOUBLE, slabs_.communicator().comm()),
         "MPI_Alltoallv");
 }

@@ -8,22 +8,21 @@
 namespace immerse {
 
 void FluidParams::validate(const Grid& grid) const {
-  static const char* axis[3] = {"x", "y", "z"};
   require(std::isfinite(rho) && rho > 0, "fluid.rho", rho, "> 0");
   require(std::isfinite(mu) && mu > 0, "fluid.mu", mu, "> 0");
   require(std::isfinite(implicit_ratio) && implicit_ratio >= 1, "implicit viscosity ratio", implicit_ratio, ">= 1");
   for (int d = 0; d < 3; ++d)
-    require(std::isfinite(body_force[d]), std::string("fluid.body_force.") + axis[d], body_force[d], "finite");
+    require(std::isfinite(body_force[d]), std::string("fluid.body_force.") + axis_name(d), body_force[d], "finite");
   for (int a = 0; a < 3; ++a) {
     if (grid.periodic(a)) continue;
     for (int d = 0; d < 3; ++d) {
-      const std::string lo = std::string("fluid.wall_velocity.") + axis[a] + "_lower." + axis[d];
-      const std::string hi = std::string("fluid.wall_velocity.") + axis[a] + "_upper." + axis[d];
+      const std::string lo = std::string("fluid.wall_velocity.") + axis_name(a) + "_lower." + axis_name(d);
+      const std::string hi = std::string("fluid.wall_velocity.") + axis_name(a) + "_upper." + axis_name(d);
       require(std::isfinite(wall_lower[a][d]), lo, wall_lower[a][d], "finite");
       require(std::isfinite(wall_upper[a][d]), hi, wall_upper[a][d], "finite");
     }
-    require(wall_lower[a][a] == wall_upper[a][a], std::string("fluid.wall_velocity.") + axis[a] + "_upper." + axis[a],
-            wall_upper[a][a], "equal to the lower wall's normal velocity (zero net flux through the walls)");
+    require(wall_lower[a][a] == wall_upper[a][a],
+            std::string("fluid.wall_velocity.") + axis_name(a) + "_upper." + axis_name(a), wall_upper[a][a], "equal to the lower wall's normal velocity (zero net flux through the walls)");
   }
 }
 

@@ -9,15 +9,14 @@
 namespace immerse {
 
 void set_poiseuille_flow(const Grid& grid, const FluidParams& params, FaceField& u) {
-  const char* axes[3] = {"x", "y", "z"};
   bool walls = false;
   for (int d = 0; d < 3; ++d) {
     if (grid.periodic(d)) continue;
     walls = true;
     require(params.body_force[d] == 0.0, "fluid.body_force",
-            std::string("zero along the wall axis ") + axes[d] + " for fluid.initial = \"poiseuille\"");
+            std::string("zero along the wall axis ") + axis_name(d) + " for fluid.initial = \"poiseuille\"");
     require(norm(params.wall_lower[d]) == 0.0 && norm(params.wall_upper[d]) == 0.0,
-            std::string("boundary.") + axes[d] + "_lower_velocity and _upper_velocity",
+            std::string("boundary.") + axis_name(d) + "_lower_velocity and _upper_velocity",
             "zero (resting walls) for fluid.initial = \"poiseuille\"");
   }
   require(walls, "fluid.initial", "\"rest\" when no axis has walls (\"poiseuille\" needs walls)");

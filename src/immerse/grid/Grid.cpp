@@ -11,10 +11,9 @@ std::string to_string(Boundary b) { return b == Boundary::Periodic ? "periodic" 
 
 Grid::Grid(std::array<int, 3> n, std::array<double, 3> lengths, std::array<Boundary, 3> bc, Vec3 origin)
     : n_(n), h_(0), origin_(origin), bc_(bc) {
-  static const char* names[3] = {"x", "y", "z"};
   for (int d = 0; d < 3; ++d) {
-    require(n[d] >= 2, std::string("grid.n") + names[d], n[d], "an integer >= 2");
-    require(std::isfinite(lengths[d]) && lengths[d] > 0, std::string("domain.L") + names[d], lengths[d],
+    require(n[d] >= 2, std::string("grid.n") + axis_name(d), n[d], "an integer >= 2");
+    require(std::isfinite(lengths[d]) && lengths[d] > 0, std::string("domain.L") + axis_name(d), lengths[d],
             "a finite length > 0");
   }
   h_ = lengths[0] / n[0];
@@ -23,7 +22,7 @@ Grid::Grid(std::array<int, 3> n, std::array<double, 3> lengths, std::array<Bound
     if (std::abs(hd - h_) > 1e-10 * h_) {
       std::ostringstream s;
       s.precision(10);
-      s << "grid: cells must be cubic, but Lx/nx = " << h_ << " and L" << names[d] << "/n" << names[d] << " = "
+      s << "grid: cells must be cubic, but Lx/nx = " << h_ << " and L" << axis_name(d) << "/n" << axis_name(d) << " = "
         << hd << " (choose counts proportional to the lengths)";
       throw InputError(s.str());
     }

@@ -16,6 +16,9 @@
 
 namespace immerse {
 
+/// "x", "y" or "z": the name of axis d (0, 1, 2) in keys and messages.
+inline const char* axis_name(int d) { return d == 0 ? "x" : d == 1 ? "y" : "z"; }
+
 enum class Boundary { Periodic, Wall };
 
 std::string to_string(Boundary b);

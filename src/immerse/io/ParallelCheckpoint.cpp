@@ -10,14 +10,6 @@
 
 namespace immerse::io {
 
-namespace {
-
-void check_mpi(int code, const char* what) {
-  if (code != MPI_SUCCESS) throw std::runtime_error(std::string("MPI error in ") + what);
-}
-
-}  // namespace
-
 void ParallelCheckpoint::check_new_name(const std::string& name) const {
   if (name.empty() || name == "." || name.find('/') != std::string::npos)
     throw std::logic_error("checkpoint: bad entry name '" + name + "'");

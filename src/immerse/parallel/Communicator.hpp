@@ -15,6 +15,9 @@
 
 namespace immerse {
 
+/// Throws std::runtime_error naming the MPI call `what` unless `code` is MPI_SUCCESS.
+void check_mpi(int code, const char* what);
+
 class Communicator {
  public:
   /// The group of every process of the program (MPI_COMM_WORLD).

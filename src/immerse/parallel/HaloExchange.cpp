@@ -10,10 +10,6 @@ namespace immerse {
 
 namespace {
 
-void check(int code, const char* what) {
-  if (code != MPI_SUCCESS) throw std::runtime_error(std::string("MPI error in ") + what);
-}
-
 /// The ghost plane `ghost` beyond a wall from the plane `inner` next to it (see the header).
 void wall_ghost(Array3& a, Layout layout, int ghost, int inner, const Vec3& wall) {
   const std::size_t n = static_cast<std::size_t>(a.nx()) * a.ny();
@@ -46,9 +42,9 @@ void HaloExchange::exchange(Array3& a, Layout layout) const {
   double* const plane_hi = a.data() + a.index(0, 0, hi - 1);
   double* const ghost_lo = a.data() + a.index(0, 0, lo - 1);
   double* const ghost_hi = a.data() + a.index(0, 0, hi);
-  check(MPI_Sendrecv(plane_lo, n, MPI_DOUBLE, down, 0, ghost_hi, n, MPI_DOUBLE, up, 0, comm, MPI_STATUS_IGNORE),
+  check_mpi(MPI_Sendrecv(plane_lo, n, MPI_DOUBLE, down, 0, ghost_hi, n, MPI_DOUBLE, up, 0, comm, MPI_STATUS_IGNORE),
         "MPI_Sendrecv");
-  check(MPI_Sendrecv(plane_hi, n, MPI_DOUBLE, up, 1, ghost_lo, n, MPI_DOUBLE, down, 1, comm, MPI_STATUS_IGNORE),
+  check_mpi(MPI_Sendrecv(plane_hi, n, MPI_DOUBLE, up, 1, ghost_lo, n, MPI_DOUBLE, down, 1, comm, MPI_STATUS_IGNORE),
         "MPI_Sendrecv");
   if (down == MPI_PROC_NULL) wall_ghost(a, layout, lo - 1, lo, wall_lower_);
   if (up == MPI_PROC_NULL) wall_ghost(a, layout, hi, hi - 1, wall_upper_);

@@ -13,10 +13,6 @@ namespace immerse {
 
 namespace {
 
-void check(int code, const char* what) {
-  if (code != MPI_SUCCESS) throw std::runtime_error(std::string("MPI error in ") + what);
-}
-
 void append(std::vector<double>& out, std::span<const Vec3> X) {
   for (const Vec3& x : X) out.insert(out.end(), {x[0], x[1], x[2]});
 }
@@ -33,14 +29,14 @@ std::vector<double> all_to_all(const Communicator& comm, const std::vector<std::
   const int size = comm.size();
   std::vector<int> send_counts(size), send_offsets(size, 0), recv_counts(size), recv_offsets(size, 0);
   for (int r = 0; r < size; ++r) send_counts[r] = static_cast<int>(out[r].size());
-  check(MPI_Alltoall(send_counts.data(), 1, MPI_INT, recv_counts.data(), 1, MPI_INT, comm.comm()), "MPI_Alltoall");
+  check_mpi(MPI_Alltoall(send_counts.data(), 1, MPI_INT, recv_counts.data(), 1, MPI_INT, comm.comm()), "MPI_Alltoall");
   for (int r = 1; r < size; ++r) {
     send_offsets[r] = send_offsets[r - 1] + send_counts[r - 1];
     recv_offsets[r] = recv_offsets[r - 1] + recv_counts[r - 1];
   }
   std::vector<double> send, recv(static_cast<std::size_t>(recv_offsets[size - 1]) + recv_counts[size - 1]);
   for (const std::vector<double>& o : out) send.insert(send.end(), o.begin(), o.end());
-  check(MPI_Alltoallv(send.data(), send_counts.data(), send_offsets.data(), MPI_DOUBLE, recv.data(),
+  check_mpi(MPI_Alltoallv(send.data(), send_counts.data(), send_offsets.data(), MPI_DOUBLE, recv.data(),
                       recv_counts.data(), recv_offsets.data(), MPI_DOUBLE, comm.comm()),
         "MPI_Alltoallv");
   return recv;

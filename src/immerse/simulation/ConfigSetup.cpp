@@ -11,7 +11,6 @@ namespace immerse {
 
 namespace {
 
-const char* kAxes[3] = {"x", "y", "z"};
 
 /// The normal velocity of each wall on its faces (as NavierStokesSolver::apply_wall_values).
 void set_wall_values(const Grid& grid, const FluidParams& params, FaceField& u) {
@@ -34,7 +33,7 @@ void set_wall_values(const Grid& grid, const FluidParams& params, FaceField& u) 
 Grid run_grid(const io::Config& c) {
   std::array<Boundary, 3> bc{};
   for (int d = 0; d < 3; ++d)
-    bc[d] = c.get<std::string>(std::string("boundary.") + kAxes[d]) == "wall" ? Boundary::Wall : Boundary::Periodic;
+    bc[d] = c.get<std::string>(std::string("boundary.") + axis_name(d)) == "wall" ? Boundary::Wall : Boundary::Periodic;
   return Grid({c.get<int>("grid.nx"), c.get<int>("grid.ny"), c.get<int>("grid.nz")},
               {c.get<double>("domain.Lx"), c.get<double>("domain.Ly"), c.get<double>("domain.Lz")}, bc,
               c.get<Vec3>("domain.origin"));
@@ -57,8 +56,8 @@ FluidParams run_fluid_params(const io::Config& c) {
     p.implicit_ratio = std::max(p.implicit_ratio, ratio);
   }
   for (int d = 0; d < 3; ++d) {
-    p.wall_lower[d] = c.get<Vec3>(std::string("boundary.") + kAxes[d] + "_lower_velocity");
-    p.wall_upper[d] = c.get<Vec3>(std::string("boundary.") + kAxes[d] + "_upper_velocity");
+    p.wall_lower[d] = c.get<Vec3>(std::string("boundary.") + axis_name(d) + "_lower_velocity");
+    p.wall_upper[d] = c.get<Vec3>(std::string("boundary.") + axis_name(d) + "_upper_velocity");
   }
   return p;
 }

@@ -19,29 +19,11 @@ namespace immerse {
 
 namespace {
 
-/// Runs f as a phase of the step profile: its wall time on this process is added to `seconds`, and it is PETSc's
-/// log event `phase` (as in ImmersedBoundaryOperator).
-template <class F>
-void timed(double& seconds, Phase phase, F&& f) {
-  const LogEvent event(phase);
-  const auto t0 = std::chrono::steady_clock::now();
-  f();
-  seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-}
-
-}  // namespace
-
-namespace {
-
 std::span<const Vec3> nodes(std::span<const double> x) {
   return {reinterpret_cast<const Vec3*>(x.data()), x.size() / 3};
 }
 
 std::span<Vec3> nodes(std::span<double> x) { return {reinterpret_cast<Vec3*>(x.data()), x.size() / 3}; }
-
-void check(int code, const char* what) {
-  if (code != MPI_SUCCESS) throw std::runtime_error(std::string("MPI error in ") + what);
-}
 
 /// Whether any process reports `failed` (collective); the same answer on every process.
 bool any_failed(const Communicator& comm, bool failed) { return comm.sum(failed ? 1.0 : 0.0) > 0; }
@@ -222,14 +204,14 @@ void DistributedOperator::add_contact_forces(std::span<const Vec3> Xf) {
   }
   std::vector<int> send_counts(size), send_offsets(size, 0), recv_counts(size), recv_offsets(size, 0);
   for (int r = 0; r < size; ++r) send_counts[r] = static_cast<int>(out[static_cast<std::size_t>(r)].size());
-  check(MPI_Alltoall(send_counts.data(), 1, MPI_INT, recv_counts.data(), 1, MPI_INT, comm.comm()), "MPI_Alltoall");
+  check_mpi(MPI_Alltoall(send_counts.data(), 1, MPI_INT, recv_counts.data(), 1, MPI_INT, comm.comm()), "MPI_Alltoall");
   for (int r = 1; r < size; ++r) {
     send_offsets[r] = send_offsets[r - 1] + send_counts[r - 1];
     recv_offsets[r] = recv_offsets[r - 1] + recv_counts[r - 1];
   }
   std::vector<double> send, recv(static_cast<std::size_t>(recv_offsets[size - 1] + recv_counts[size - 1]));
   for (const auto& o : out) send.insert(send.end(), o.begin(), o.end());
-  check(MPI_Alltoallv(send.data(), send_counts.data(), send_offsets.data(), MPI_DOUBLE, recv.data(),
+  check_mpi(MPI_Alltoallv(send.data(), send_counts.data(), send_offsets.data(), MPI_DOUBLE, recv.data(),
                       recv_counts.data(), recv_offsets.data(), MPI_DOUBLE, comm.comm()),
         "MPI_Alltoallv");
   // The owned and the received membranes, concatenated in ascending global index.

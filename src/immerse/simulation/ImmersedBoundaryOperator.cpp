@@ -21,21 +21,6 @@ namespace immerse {
 
 namespace {
 
-/// Runs f and adds its wall time to `seconds`.
-template <class F>
-void timed(double& seconds, F&& f) {
-  const auto t0 = std::chrono::steady_clock::now();
-  f();
-  seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-}
-
-/// Runs f as a phase of the step profile: its wall time is added to `seconds` and it is PETSc's log event `phase`.
-template <class F>
-void timed(double& seconds, Phase phase, F&& f) {
-  const LogEvent event(phase);
-  timed(seconds, std::forward<F>(f));
-}
-
 /// dst = src (resized), copied by the threads: the trial state's positions and velocities are saved at every
 /// evaluation of the implicit residual.
 template <class T>

@@ -50,7 +50,6 @@ std::string inversion_details(const Grid& grid, const ElasticMembrane& membrane,
   std::ostringstream s;
   s.precision(3);
   s << "; area ratio " << ratio << " (least of the membrane " << least.ratio << ", element " << least.element << ")";
-  static const char* const axes[3] = {"x", "y", "z"};
   double wall = std::numeric_limits<double>::infinity();
   int axis = -1;
   double at = 0;
@@ -61,7 +60,7 @@ std::string inversion_details(const Grid& grid, const ElasticMembrane& membrane,
       if (x[a] - lo < wall) wall = x[a] - lo, axis = a, at = lo;
       if (hi - x[a] < wall) wall = hi - x[a], axis = a, at = hi;
     }
-  if (axis >= 0) s << ", " << wall << " m from the wall " << axes[axis] << " = " << std::setprecision(10) << at
+  if (axis >= 0) s << ", " << wall << " m from the wall " << axis_name(axis) << " = " << std::setprecision(10) << at
                    << std::setprecision(3);
   if (std::isfinite(nearest.distance))
     s << ", " << nearest.distance << " m from membrane[" << nearest.membrane << "]";

@@ -23,7 +23,6 @@ namespace immerse {
 
 namespace {
 
-const char* kAxes[3] = {"x", "y", "z"};
 
 Shape shape_of(const io::Config& m, bool reference) {
   Shape s;
@@ -282,7 +281,7 @@ void Builder::check_geometry() const {
           std::minmax_element(X.begin(), X.end(), [&](const Vec3& p, const Vec3& q) { return p[a] < q[a]; });
       if ((*hi)[a] - (*lo)[a] >= grid_.length(a)) {
         std::ostringstream s;
-        s << membrane_name(m) << " spans " << (*hi)[a] - (*lo)[a] << " m along " << kAxes[a]
+        s << membrane_name(m) << " spans " << (*hi)[a] - (*lo)[a] << " m along " << axis_name(a)
           << ": must be shorter than the periodic box (" << grid_.length(a) << " m)" << unit_hint(config_, m);
         throw InputError(s.str());
       }

@@ -2,7 +2,11 @@
 // Wall time spent in each part of the coupled step of §3 (ImmersedBoundaryOperator): the profile of a run by
 // component. The nonlinear solver's own work (vector operations, the finite differences of eq. 36) is what a
 // caller's total wall time leaves over.
+#include <chrono>
 #include <string>
+#include <utility>
+
+#include "immerse/timestep/LogEvent.hpp"
 
 namespace immerse {
 
@@ -23,5 +27,21 @@ struct StepTimings {
   /// per cent of the wall time.
   std::string profile(double wall_seconds, long steps) const;
 };
+
+/// Runs f and adds its wall time to `seconds`.
+template <class F>
+void timed(double& seconds, F&& f) {
+  const auto t0 = std::chrono::steady_clock::now();
+  std::forward<F>(f)();
+  seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+/// Runs f as a phase of the step profile: its wall time on this process is added to `seconds`, and it is PETSc's
+/// log event `phase`.
+template <class F>
+void timed(double& seconds, Phase phase, F&& f) {
+  const LogEvent event(phase);
+  timed(seconds, std::forward<F>(f));
+}
 
 }  // namespace immerse

@@ -7,6 +7,7 @@
 #include <stdexcept>
 
 #include "immerse/core/Error.hpp"
+#include "immerse/parallel/Communicator.hpp"
 #include "immerse/timestep/LogEvent.hpp"
 #include "immerse/timestep/PetscSession.hpp"
 
@@ -277,8 +278,7 @@ PetscErrorCode SnesIntegrator::gmres_converged(KSP ksp, PetscInt it, PetscReal r
 bool SnesIntegrator::any_process(bool flag) const {
   if (!distributed_) return flag;
   int mine = flag ? 1 : 0, any = 0;
-  if (MPI_Allreduce(&mine, &any, 1, MPI_INT, MPI_MAX, comm_) != MPI_SUCCESS)
-    throw std::runtime_error("MPI error in MPI_Allreduce");
+  check_mpi(MPI_Allreduce(&mine, &any, 1, MPI_INT, MPI_MAX, comm_), "MPI_Allreduce");
   return any != 0;
 }
 
