@@ -351,9 +351,13 @@ TEST(RunMpi, BadInputOnThreeProcessesIsOneLineAndWritesNothing) {
   expect_refused(run_mpi(3, args, dir / "dense"), dir / "dense", "time.scheme = \"bfgs\"");
   args = run_args(scenario_file("rbc_stretch.toml"), dir / "kind", {"time.scheme=rk2"});
   expect_refused(run_mpi(3, args, dir / "kind"), dir / "kind", "scenario.kind = \"rbc_stretch\"");
+}
+
+TEST(RunMpi, CheckpointOfAnotherGridAndTheFolderOfAnotherRunAreRefusedOnThreeProcesses) {
+  ScratchDir dir("run_mpi");
   // A checkpoint of another grid (the same channel at twice the resolution).
   ASSERT_EQ(run_mpi(2, channel_args(dir / "two", 3), dir / "two").status, 0);
-  args = channel_args(dir / "other_grid", 6, dir / "two" / "checkpoint.h5");
+  auto args = channel_args(dir / "other_grid", 6, dir / "two" / "checkpoint.h5");
   args.insert(args.end(), {"--set", "grid.nx=96", "--set", "grid.ny=192", "--set", "grid.nz=48"});
   expect_refused(run_mpi(3, args, dir / "other_grid"), dir / "other_grid", "grid.nx = 96: the checkpoint");
   // The folder of another run.
