@@ -21,8 +21,9 @@
 
 namespace immerse {
 
-namespace {
+std::string membrane_name(std::size_t m) { return "membrane[" + std::to_string(m) + "]"; }
 
+namespace {
 
 Shape shape_of(const io::Config& m, bool reference) {
   Shape s;
@@ -62,8 +63,6 @@ MaterialLaw in_plane_law_of(const io::Config& m) {
 MaterialLaw law_of(const io::Config& m) {
   return with_area_dilation(in_plane_law_of(m), m.get<double>("dilation_modulus"));
 }
-
-std::string membrane_name(std::size_t m) { return "membrane[" + std::to_string(m) + "]"; }
 
 // mesh.reference_file must be mesh.file in another shape: the same nodes joined into the same elements.
 void check_same_elements(const Mesh& reference, const Mesh& mesh) {

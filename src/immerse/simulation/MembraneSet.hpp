@@ -24,6 +24,9 @@
 
 namespace immerse {
 
+/// "membrane[m]": membrane m as keys and messages name it.
+std::string membrane_name(std::size_t m);
+
 struct MembraneSet {
   std::vector<Mesh> meshes;                                 ///< nodes at the initial positions
   std::vector<std::vector<Vec3>> references, initial;       ///< per membrane, global order

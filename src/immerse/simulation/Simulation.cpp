@@ -18,12 +18,6 @@
 
 namespace immerse {
 
-namespace {
-
-std::string membrane_name(std::size_t m) { return "membrane[" + std::to_string(m) + "]"; }
-
-}  // namespace
-
 Simulation::Simulation(const io::Config& config, const std::function<bool()>& stop_requested)
     : config_(config),
       end_time_(config.get<double>("time.end")),
