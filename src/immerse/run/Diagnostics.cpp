@@ -31,6 +31,7 @@ const std::vector<Column> kMembraneColumns{
     {"a2", "m", "semi-axis of the equivalent ellipsoid closest to y"},
     {"a3", "m", "semi-axis of the equivalent ellipsoid closest to z"},
     {"D_xz", "1", "Taylor deformation (L - B) / (L + B) of the section by the x-z plane through the centroid"},
+    {"D_ellipsoid", "1", "Taylor deformation (a - b) / (a + b) of the equivalent ellipsoid in the x-z plane"},
     {"theta", "rad", "inclination of the longest principal axis to x in the x-z plane"},
     {"min_area_ratio", "1",
      "least ratio of an element's area to its area in the stress-free reference (the local area dilation J)"}};
@@ -105,6 +106,14 @@ std::array<double, 3> semi_axes_along_xyz(const MembraneGeometry& g) {
   return a;
 }
 
+double ellipsoid_deformation(const MembraneGeometry& g) {
+  int normal = 0;  // the principal axis closest to y, normal to the plane of shear
+  for (int k = 1; k < 3; ++k)
+    if (std::abs(g.axes[k].y) > std::abs(g.axes[normal].y)) normal = k;
+  const double a = g.semi_axes[normal == 0 ? 1 : 0], b = g.semi_axes[normal == 2 ? 1 : 2];
+  return a + b > 0 ? (a - b) / (a + b) : 0;
+}
+
 double inclination(const MembraneGeometry& g) {
   double t = std::atan2(g.axes[0].z, g.axes[0].x);
   if (t > M_PI / 2) t -= M_PI;
@@ -128,7 +137,7 @@ std::vector<double> Diagnostics::row(const SimulationInterface& sim, const StepR
     const ShearPlaneProfile p = shear_plane_profile(sim.mesh(m), X, g.centroid);
     const auto a = semi_axes_along_xyz(g);
     row.insert(row.end(), {g.volume, g.area, g.centroid.x, g.centroid.y, g.centroid.z, a[0], a[1], a[2], p.D_xz,
-                           inclination(g),
+                           ellipsoid_deformation(g), inclination(g),
                            least_area_ratio(sim.mesh(m), X, sim.membrane(m).reference_element_areas()).ratio});
     scenario_.add_membrane_values(X, row);
   }

@@ -45,6 +45,10 @@ std::string energy_budget_note(const std::filesystem::path& checkpoint, long ste
 
 /// The principal semi-axes ordered by the coordinate axis their direction is closest to (a1 ~ x, a2 ~ y, a3 ~ z).
 std::array<double, 3> semi_axes_along_xyz(const MembraneGeometry& g);
+/// Taylor deformation (a - b)/(a + b) of the equivalent ellipsoid in the plane of shear: a >= b its two semi-axes
+/// other than the one closest to y. Unlike D_xz, it averages over the whole surface, so node-scale roughness does not
+/// bias it.
+double ellipsoid_deformation(const MembraneGeometry& g);
 /// Inclination of the longest principal axis to the flow (x), in the x-z plane, in (-pi/2, pi/2].
 double inclination(const MembraneGeometry& g);
 
