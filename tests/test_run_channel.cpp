@@ -27,9 +27,9 @@ TEST(RbcChannel, ThirtyTwoCellsInAPoiseuilleDuctWithTheirDiagnostics) {
   ASSERT_EQ(rows.size(), 4u);  // header, steps 0, 1, 2
   const auto& head = rows[0];
   // The membranes' columns, mean_velocity, then the energy budget (4 fluid columns, 3 per cell, 2 totals).
-  EXPECT_EQ(head[8u + 32u * 13u], "mean_velocity");
+  EXPECT_EQ(head[8u + 32u * 14u], "mean_velocity");
   EXPECT_EQ(head.back(), "budget_residual");
-  EXPECT_EQ(head.size(), 8u + 32u * 13u + 1u + 4u + 32u * 3u + 2u);
+  EXPECT_EQ(head.size(), 8u + 32u * 14u + 1u + 4u + 32u * 3u + 2u);
   auto column = [&](const std::string& name) {
     const auto it = std::find(head.begin(), head.end(), name);
     EXPECT_NE(it, head.end()) << name;

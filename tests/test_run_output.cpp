@@ -96,10 +96,11 @@ TEST_F(RunOutputTest, FilesRecordTheirProvenanceAndUnits) {
   }
   EXPECT_EQ(units[2][1], "s");    // time
   EXPECT_EQ(units[9][1], "m^3");  // volume
-  EXPECT_EQ(units[19][1], "1");   // min_area_ratio
-  EXPECT_EQ(units[20][1], "J");   // E_kinetic
-  EXPECT_EQ(units[21][1], "W");   // dissipation
-  EXPECT_EQ(units[28][1], "J");   // budget_residual
+  EXPECT_EQ(units[18][1], "1");   // D_ellipsoid
+  EXPECT_EQ(units[20][1], "1");   // min_area_ratio
+  EXPECT_EQ(units[21][1], "J");   // E_kinetic
+  EXPECT_EQ(units[22][1], "W");   // dissipation
+  EXPECT_EQ(units[29][1], "J");   // budget_residual
 }
 
 TEST_F(RunOutputTest, DiagnosticsHaveTheDocumentedHeaderAndOneRowPerStep) {
@@ -184,27 +185,27 @@ TEST(OutputWriter, WithoutFieldsNoParaViewFilesAndAPrefixPerMembrane) {
   ASSERT_EQ(run_command(o, log, err), 0) << err.str();
   const auto rows = read_csv(o.out / "diagnostics.csv");
   ASSERT_EQ(rows.size(), 4u);
-  ASSERT_EQ(rows[0].size(), 8u + 2 * 11 + 4 + 2 * 3 + 2);
+  ASSERT_EQ(rows[0].size(), 8u + 2 * 12 + 4 + 2 * 3 + 2);
   EXPECT_EQ(rows[0][8], "m0_volume");
-  EXPECT_EQ(rows[0][18], "m0_min_area_ratio");
-  EXPECT_EQ(rows[0][19], "m1_volume");
-  EXPECT_EQ(rows[0][28], "m1_theta");
+  EXPECT_EQ(rows[0][19], "m0_min_area_ratio");
+  EXPECT_EQ(rows[0][20], "m1_volume");
+  EXPECT_EQ(rows[0][30], "m1_theta");
   // Then the energy budget: the fluid's columns, each membrane's energies, the totals.
-  EXPECT_EQ(rows[0][30], "E_kinetic");
-  EXPECT_EQ(rows[0][34], "m0_E_elastic");
-  EXPECT_EQ(rows[0][39], "m1_E_constraint");
-  EXPECT_EQ(rows[0][40], "E_total");
-  EXPECT_EQ(rows[0][41], "budget_residual");
+  EXPECT_EQ(rows[0][32], "E_kinetic");
+  EXPECT_EQ(rows[0][36], "m0_E_elastic");
+  EXPECT_EQ(rows[0][41], "m1_E_constraint");
+  EXPECT_EQ(rows[0][42], "E_total");
+  EXPECT_EQ(rows[0][43], "budget_residual");
   // E_total adds up the kinetic energy and the energies of both (stretched) capsules.
-  const double E_total = std::stod(rows[3][40]);
-  EXPECT_NEAR(E_total, std::stod(rows[3][30]) + std::stod(rows[3][34]) + std::stod(rows[3][37]), 1e-15 * E_total);
-  EXPECT_GT(std::stod(rows[3][34]), 0);
-  EXPECT_GT(std::stod(rows[3][37]), 0);
+  const double E_total = std::stod(rows[3][42]);
+  EXPECT_NEAR(E_total, std::stod(rows[3][32]) + std::stod(rows[3][36]) + std::stod(rows[3][39]), 1e-15 * E_total);
+  EXPECT_GT(std::stod(rows[3][36]), 0);
+  EXPECT_GT(std::stod(rows[3][39]), 0);
   // Mirror images about x = 1 in a symmetric box: same volumes, least area ratios and centroids at 0.5 and 1.5.
-  EXPECT_NEAR(std::stod(rows[3][8]), std::stod(rows[3][19]), 1e-12);
-  EXPECT_NEAR(std::stod(rows[3][18]), std::stod(rows[3][29]), 1e-9);
+  EXPECT_NEAR(std::stod(rows[3][8]), std::stod(rows[3][20]), 1e-12);
+  EXPECT_NEAR(std::stod(rows[3][19]), std::stod(rows[3][31]), 1e-9);
   EXPECT_NEAR(std::stod(rows[3][10]), 0.5, 1e-3);
-  EXPECT_NEAR(std::stod(rows[3][21]), 1.5, 1e-3);
+  EXPECT_NEAR(std::stod(rows[3][22]), 1.5, 1e-3);
   EXPECT_FALSE(fs::exists(o.out / "membranes.xdmf"));
   EXPECT_FALSE(fs::exists(o.out / "fluid.xdmf"));
   EXPECT_FALSE(fs::exists(o.out / "fields_000000.h5"));
