@@ -116,8 +116,8 @@ TEST(MembraneAtRest, TotalEnergyNeverRisesForAnyLawMeshKernelOrScheme) {
 
 // The same capsule to t = 200 (1,600 steps, octahedral level 2 with bending, 16^3) with the global volume constraint
 // (k_V = 10, 20 E_s / a): it relaxes to a sphere and stays there. E_total never rises, the shape stays spherical
-// (D_xz settles at a plateau the coarse mesh sets and does not grow), the volume within 2 %. Without the constraint fluid crosses the prestressed membrane (docs/energy-budget.md):
-// 2.8 % of the volume by t = 200 at this size, D_xz 7.8e-3.
+// (D_xz settles at a plateau the coarse mesh sets and does not grow), the volume within 2 %. Without the constraint
+// fluid crosses the prestressed membrane (docs/energy-budget.md): 2.8 % of the volume by t = 200 at this size.
 TEST(MembraneAtRest, LongRunRelaxesToTheSphereAndStaysThere) {
   ScratchDir dir("at_rest_long");
   std::vector<std::string> sets = small_run_sets(1600);

@@ -112,8 +112,8 @@ TEST_F(RunOutputTest, DiagnosticsHaveTheDocumentedHeaderAndOneRowPerStep) {
   std::string header;
   for (const auto& c : rows[0]) header += (header.empty() ? "" : ",") + c;
   EXPECT_EQ(header,
-            "step,time,dt,newton_its,gmres_its,fluid_solves,residual,wall_s,volume,area,cx,cy,cz,a1,a2,a3,D_xz,D_ellipsoid,theta,"
-            "min_area_ratio,E_kinetic,dissipation,P_walls,P_body,E_elastic,E_bending,E_constraint,E_total,budget_residual");
+            "step,time,dt,newton_its,gmres_its,fluid_solves,residual,wall_s,volume,area,cx,cy,cz,a1,a2,a3,D_xz,"
+            "D_ellipsoid,theta,min_area_ratio,E_kinetic,dissipation,P_walls,P_body,E_elastic,E_bending,E_constraint,E_total,budget_residual");
   for (int s = 1; s <= kSteps; ++s) {
     const auto& r = rows[s + 1];
     ASSERT_EQ(r.size(), rows[0].size());

@@ -22,7 +22,8 @@ void FluidParams::validate(const Grid& grid) const {
       require(std::isfinite(wall_upper[a][d]), hi, wall_upper[a][d], "finite");
     }
     require(wall_lower[a][a] == wall_upper[a][a],
-            std::string("fluid.wall_velocity.") + axis_name(a) + "_upper." + axis_name(a), wall_upper[a][a], "equal to the lower wall's normal velocity (zero net flux through the walls)");
+            std::string("fluid.wall_velocity.") + axis_name(a) + "_upper." + axis_name(a), wall_upper[a][a],
+            "equal to the lower wall's normal velocity (zero net flux through the walls)");
   }
 }
 

@@ -38,11 +38,11 @@ ShearPlaneProfile shear_plane_profile(const Mesh& mesh, const std::vector<Vec3>&
       for (int i = 0; i + j <= n; ++i) P[at(i, j)] = MeshElement::position(x, double(i) / n, double(j) / n);
     for (int j = 0; j < n; ++j)
       for (int i = 0; i + j < n; ++i) {
+        // The edges of the triangles (i, j), (i + 1, j), (i, j + 1) are every edge of the division, each once.
         const Vec3 &p = P[at(i, j)], &q = P[at(i + 1, j)], &r = P[at(i, j + 1)];
         cut(p, q);
         cut(q, r);
         cut(r, p);
-        if (i + j + 1 < n) cut(q, P[at(i + 1, j + 1)]), cut(P[at(i + 1, j + 1)], r);
       }
   }
   ShearPlaneProfile p;

@@ -4,8 +4,9 @@
 // centroid). The section is that of the curved elements (eq. 38): each element's parent triangle is divided into
 // kDivisions² flat triangles at points of the curved surface, and the plane cuts their edges. (Cut through the four
 // flat sub-triangles of each element instead, a sphere of 642 nodes has D_xz = 1.7e-3 at rest, the deformation of
-// G = 0.0003; through the curved elements 8.6e-5, and 1.9e-6 with 10,242 nodes.) The maximum and the minimum take any node-scale roughness of the surface
-// at full weight; the equivalent ellipsoid's D_ellipsoid (diagnostics.csv) does not.
+// G = 0.0003; through the curved elements 8.6e-5, and 1.9e-6 with 10,242 nodes.) The maximum and the minimum take
+// any node-scale roughness of the surface at full weight; the equivalent ellipsoid's D_ellipsoid (diagnostics.csv)
+// does not.
 // (The inclination is taken from the principal axes instead: the direction of L jumps from node to node as the
 // membrane tank-treads.)
 // Verified by the tests ShearPlaneProfile.* (tests/test_shear_plane_profile.cpp: a sphere and an ellipsoid of known
