@@ -281,6 +281,15 @@ void ImmersedBoundaryOperator::correct_positions(std::size_t m, const std::vecto
   start_valid_ = false;
 }
 
+void ImmersedBoundaryOperator::prepare_preconditioner(std::span<const double> X, double c) {
+  timed(timings_.preconditioner, Phase::PreconditionerSetup, [&] { preconditioner_->prepare(nodes(X), offset_, c); });
+}
+
+void ImmersedBoundaryOperator::apply_preconditioner(std::span<const double> v, std::span<double> z) {
+  timed(timings_.preconditioner, Phase::PreconditionerApply,
+        [&] { preconditioner_->apply(nodes(v), {reinterpret_cast<Vec3*>(z.data()), z.size() / 3}); });
+}
+
 double ImmersedBoundaryOperator::min_wall_distance() const { return immerse::min_wall_distance(fluid_.grid(), X_); }
 
 }  // namespace immerse

@@ -36,6 +36,7 @@
 #include "immerse/coupling/ViscosityIndicator.hpp"
 #include "immerse/fluid/NavierStokesSolver.hpp"
 #include "immerse/membrane/ElasticMembrane.hpp"
+#include "immerse/simulation/CellPreconditioner.hpp"
 #include "immerse/simulation/StepTimings.hpp"
 #include "immerse/timestep/CoupledOperator.hpp"
 
@@ -66,6 +67,11 @@ class ImmersedBoundaryOperator final : public CoupledOperator {
   bool trial_matches(std::span<const double> X) const override { return std::ranges::equal(X, trial_X_); }
   void commit(std::span<const double> X, double dt) override;
   std::size_t fluid_solves() const override { return solves_; }
+  bool has_preconditioner() const override { return preconditioner_ != nullptr; }
+  void prepare_preconditioner(std::span<const double> X, double c) override;
+  void apply_preconditioner(std::span<const double> v, std::span<double> z) override;
+  /// Preconditions the implicit step by `p` (CellPreconditioner.hpp), one cell per membrane.
+  void set_preconditioner(std::shared_ptr<CellPreconditioner> p) { preconditioner_ = std::move(p); }
 
   const FluidState& fluid_state() const { return committed_; }
   /// Wall time spent so far in each part of the coupled step (since construction, which evaluates the forces once).
@@ -142,6 +148,7 @@ class ImmersedBoundaryOperator final : public CoupledOperator {
   std::size_t solves_ = 0;
   StepTimings timings_;
   ThreadGovernor governor_;
+  std::shared_ptr<CellPreconditioner> preconditioner_;  ///< none by default
   std::vector<CouplingPoints> membrane_points_;  ///< each membrane's coupling points
   CouplingPoints points_;                        ///< all membranes' coupling points, concatenated
 };

@@ -178,6 +178,12 @@ ConfigSchema run_schema() {
   s.add_string("solver.initial_guess", "recurrence", {"recurrence", "extrapolation"},
                "Newton's start: the linear extrapolation of §3 step 1 plus the error a recurrence fitted to the last "
                "steps' errors predicts (recurrence), or the extrapolation alone (extrapolation, the paper's)");
+  s.add_string("solver.preconditioner", "none", {"none", "cells"},
+               "time.scheme = jfnk: GMRES unpreconditioned (none, the paper's) or right-preconditioned per cell by "
+               "I + c M_c K_c on the cell's coarse points (cells: CellPreconditioner.hpp; generated meshes of level >= 2; "
+               "PETSc's PCSHELL, -pc_type none switches it off)");
+  s.add_int("solver.preconditioner_level", 1, Range::closed(0, 5),
+            "solver.preconditioner = cells: subdivision level of each cell's coarse points (1: 162 icosahedral points)");
   s.add_string("solver.petsc_options", "", {},
                "PETSc options of the implicit schemes' solver (jfnk: SNES, KSP, PC, MatMFFD; anderson, lbfgs: SNES) "
                "and of PETSc itself (-log_view, -options_left), e.g. \"-ksp_gmres_restart 50 -snes_converged_reason\"; "
