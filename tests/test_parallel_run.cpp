@@ -201,12 +201,6 @@ TEST(ParallelRun, RedCellChannelRk2EqualsTheOneProcessRun) { compare_with_serial
 
 TEST(ParallelRun, RedCellChannelEulerEqualsTheOneProcessRun) { compare_with_serial("euler", kEulerSteps); }
 
-// Each cell meets the fluid through the 162 nodes of its level-1 mesh (mesh.coupling_level): the transfer between nodes
-// and points goes with the cell to its new owner.
-TEST(ParallelRun, RedCellChannelThroughCoarserCouplingPointsEqualsTheOneProcessRun) {
-  compare_with_serial("rk2", kEulerSteps, {"membrane[0].mesh.coupling_level=1"});
-}
-
 // Contact between the layers of cells: with a range of 1.5 um (3 h) the nodes of the cells of neighbouring layers,
 // owned by different processes on 2, 3 and 4 processes, and those of the outer layers and the walls repel each other
 // from the first step on.

@@ -121,7 +121,7 @@ bool start_or_restore(SimulationInterface& sim, ScenarioRun& scenario, const std
 StepTimings largest(const StepTimings& t, const Communicator& comm) {
   if (comm.size() == 1) return t;
   const auto most = [&](double x) { return -min_over_processes(comm, -x); };
-  return {most(t.force), most(t.contact), most(t.spread), most(t.fluid), most(t.interpolate), most(t.preconditioner)};
+  return {most(t.force), most(t.contact), most(t.spread), most(t.fluid), most(t.interpolate)};
 }
 
 // Collective: every process computes what rank 0 prints.

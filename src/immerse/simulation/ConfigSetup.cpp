@@ -6,7 +6,6 @@
 
 #include "immerse/core/Error.hpp"
 #include "immerse/fluid/PoiseuilleFlow.hpp"
-#include "immerse/membrane/MeshGenerator.hpp"
 
 namespace immerse {
 
@@ -77,7 +76,6 @@ SolverSettings run_solver_settings(const io::Config& c) {
   s.anderson_memory = c.get<int>("solver.anderson_memory");
   s.anderson_beta = c.get<double>("solver.anderson_beta");
   s.petsc_options = c.get<std::string>("solver.petsc_options");
-  s.preconditioner = c.get<std::string>("solver.preconditioner");
   s.initial_guess = c.get<std::string>("solver.initial_guess") == "extrapolation"
                         ? SolverSettings::InitialGuess::Extrapolation
                         : SolverSettings::InitialGuess::Recurrence;
@@ -116,35 +114,6 @@ FluidState run_initial_fluid_state(const io::Config& config, const Grid& grid, c
   }
   set_wall_values(grid, params, s.u);
   return s;
-}
-
-std::shared_ptr<CellPreconditioner> run_cell_preconditioner(const io::Config& config, const MembraneSet& set,
-                                                            const Grid& grid) {
-  if (config.get<std::string>("solver.preconditioner") != "cells") return nullptr;
-  const int coarse_level = config.get<int>("solver.preconditioner_level");
-  std::vector<CellPreconditioner::Cell> cells;
-  for (std::size_t m = 0; m < set.membranes.size(); ++m) {
-    // With [packing] every cell is a copy of membrane[0].
-    const io::Config& entry = config.entry("membrane", config.count("membrane") == 1 ? 0 : m);
-    const std::string family = entry.get<std::string>("mesh.family");
-    const int level = entry.get<int>("mesh.level");
-    if (family == "file" || level <= coarse_level)
-      throw InputError("solver.preconditioner = \"cells\": " + membrane_name(m) +
-                       " needs a generated mesh (mesh.family icosahedral or octahedral) of a level above "
-                       "solver.preconditioner_level (" + std::to_string(coarse_level) + ")");
-    const auto sphere = [&](int l) { return family == "icosahedral" ? icosahedral_sphere(l) : octahedral_sphere(l); };
-    Mesh coarse = sphere(coarse_level);
-    CouplingPoints points(sphere(level), coarse);
-    std::vector<Vec3> reference(points.num_points());
-    points.gather(set.references[m], reference);
-    coarse.nodes = reference;
-    auto model = std::make_unique<ElasticMembrane>(coarse, reference, set.membranes[m]->law(), Bending{},
-                                                   ForceMethod::Energy);
-    cells.push_back({std::move(points), std::move(model)});
-  }
-  // Hydrodynamic radius of a blob: 0.91 h for the 3-point kernel, 1.26 h for the 4-point one.
-  const double radius = (config.get<std::string>("coupling.kernel") == "peskin4" ? 1.26 : 0.91) * grid.h();
-  return std::make_shared<CellPreconditioner>(std::move(cells), config.get<double>("fluid.mu"), radius);
 }
 
 }  // namespace immerse

@@ -5,16 +5,12 @@
 // same way. The membranes are MembraneSet's.
 // Verified by: the tests of Simulation (test_simulation_*) and ParallelRun.* (the distributed run equals the
 // one-process run of the same configuration).
-#include <memory>
-
 #include "immerse/contact/ContactForce.hpp"
 #include "immerse/fluid/FftHelmholtzSolver.hpp"
 #include "immerse/fluid/FluidParams.hpp"
 #include "immerse/fluid/FluidState.hpp"
 #include "immerse/grid/Grid.hpp"
 #include "immerse/io/Config.hpp"
-#include "immerse/simulation/CellPreconditioner.hpp"
-#include "immerse/simulation/MembraneSet.hpp"
 #include "immerse/timestep/MembraneIntegrator.hpp"
 
 namespace immerse {
@@ -29,11 +25,6 @@ FftPlanning run_fft_planning(const io::Config& config);
 ContactSettings run_contact_settings(const io::Config& config);
 /// time.theta and solver.*.
 SolverSettings run_solver_settings(const io::Config& config);
-/// solver.preconditioner = "cells": the cells' preconditioner for the membranes of `set` (generated meshes of a level
-/// above solver.preconditioner_level, InputError otherwise), blobs of the kernel's hydrodynamic radius in fluid.mu;
-/// nullptr for "none".
-std::shared_ptr<CellPreconditioner> run_cell_preconditioner(const io::Config& config, const MembraneSet& set,
-                                                            const Grid& grid);
 /// The fluid at t = 0 on the whole grid (fluid.initial: at rest, Poiseuille or Couette flow), wall velocities set.
 FluidState run_initial_fluid_state(const io::Config& config, const Grid& grid, const FluidParams& params);
 

@@ -34,24 +34,19 @@ DistributedOperator::DistributedOperator(SlabNavierStokesSolver& fluid, SlabIBCo
                                          std::vector<const ElasticMembrane*> membranes,
                                          std::span<const std::vector<Vec3>> X0,
                                          std::span<const std::vector<Vec3>> reference, FluidState fluid_state,
-                                         const ContactSettings& contact, std::vector<double> viscosity_ratio,
-                                         std::vector<CouplingPoints> coupling)
+                                         const ContactSettings& contact, std::vector<double> viscosity_ratio)
     : fluid_(fluid),
       coupler_(coupler),
       membranes_(std::move(membranes)),
       contact_(contact),
       ownership_(fluid.decomposition(), X0, reference),
-      committed_(std::move(fluid_state)),
-      membrane_points_(std::move(coupling)) {
+      committed_(std::move(fluid_state)) {
   if (X0.size() != membranes_.size()) throw std::logic_error("DistributedOperator: one position array per membrane");
   for (std::size_t m = 0; m < membranes_.size(); ++m) {
     if (X0[m].size() != membranes_[m]->num_nodes())
       throw InputError("membrane[" + std::to_string(m) + "]: " + std::to_string(X0[m].size()) +
                        " initial positions for a mesh of " + std::to_string(membranes_[m]->num_nodes()) + " nodes");
     total_nodes_ += X0[m].size();
-    if (membrane_points_.size() < membranes_.size()) membrane_points_.emplace_back(X0[m].size());
-    if (membrane_points_.size() != membranes_.size() || membrane_points_[m].num_nodes() != X0[m].size())
-      throw std::logic_error("DistributedOperator: one set of coupling points per membrane, on its nodes");
     moduli_.push_back(small_strain_area_modulus(membranes_[m]->law()));
   }
   if (contact_.range > 0)  // refuses a range of half a periodic length or more (InputError), on every process alike
@@ -65,7 +60,7 @@ DistributedOperator::DistributedOperator(SlabNavierStokesSolver& fluid, SlabIBCo
   }
   refresh();
   U_.resize(X_.size());
-  timed(timings_.interpolate, Phase::Interpolation, [&] { points_.interpolate(coupler_, committed_.u, X_, U_); });
+  timed(timings_.interpolate, Phase::Interpolation, [&] { coupler_.interpolate_velocity(committed_.u, X_, U_); });
 }
 
 void DistributedOperator::update_indicator(std::span<const Vec3> Xf) {
@@ -84,12 +79,7 @@ void DistributedOperator::update_indicator(std::span<const Vec3> Xf) {
 void DistributedOperator::refresh() {
   X_ = ownership_.owned_positions();
   offset_.assign(1, 0);
-  std::vector<const CouplingPoints*> parts;
-  for (const OwnedMembrane& m : ownership_.owned()) {
-    offset_.push_back(offset_.back() + m.positions.size());
-    parts.push_back(&membrane_points_[static_cast<std::size_t>(m.id)]);
-  }
-  points_ = CouplingPoints::concatenate(parts);
+  for (const OwnedMembrane& m : ownership_.owned()) offset_.push_back(offset_.back() + m.positions.size());
 }
 
 std::vector<std::size_t> DistributedOperator::membrane_offsets() const {
@@ -268,11 +258,11 @@ void DistributedOperator::trial_step(std::span<const double> Xf, double theta, d
   trial_done_ = false;
   if (theta < 1.0 && !start_valid_) {  // S(X^n) f(X^n), once per step unless the last trial left it
     nodal_forces(X_);
-    timed(timings_.spread, Phase::Spreading, [&] { points_.spread(coupler_, X_, F_, force_start_); });
+    timed(timings_.spread, Phase::Spreading, [&] { coupler_.spread_force(X_, F_, force_start_); });
     start_valid_ = true;
   }
   nodal_forces(nodes(Xf));
-  timed(timings_.spread, Phase::Spreading, [&] { points_.spread(coupler_, nodes(Xf), F_, force_); });
+  timed(timings_.spread, Phase::Spreading, [&] { coupler_.spread_force(nodes(Xf), F_, force_); });
   if (theta < 1.0) {  // F^{n+1/2} = theta S(Xf) f(Xf) + (1 - theta) S(X^n) f(X^n), as ImmersedBoundaryOperator
     mixed_ = force_;
     for (int d = 0; d < 3; ++d) {
@@ -294,7 +284,7 @@ void DistributedOperator::trial_velocity(std::span<const double> Xf, double thet
   governed([&] {
     trial_step(Xf, theta, dt);
     timed(timings_.interpolate, Phase::Interpolation,
-          [&] { points_.interpolate(coupler_, trial_.u, nodes(Xi), nodes(U)); });
+          [&] { coupler_.interpolate_velocity(trial_.u, nodes(Xi), nodes(U)); });
   });
   trial_X_.assign(Xf.begin(), Xf.end());
   trial_done_ = true;
@@ -313,15 +303,14 @@ void DistributedOperator::trial_mean_velocity(std::span<const double> Xf, std::s
       for (std::size_t i = 0; i < o.size(); ++i) o[i] = 0.5 * x[i] + 0.5 * y[i];
     }
     timed(timings_.interpolate, Phase::Interpolation,
-          [&] { points_.interpolate(coupler_, mean_, nodes(Xi), nodes(U)); });
+          [&] { coupler_.interpolate_velocity(mean_, nodes(Xi), nodes(U)); });
   });
   trial_X_.assign(Xf.begin(), Xf.end());
   trial_done_ = true;
 }
 
 void DistributedOperator::committed_velocity(std::span<const double> Xi, std::span<double> U) {
-  timed(timings_.interpolate, Phase::Interpolation,
-        [&] { points_.interpolate(coupler_, committed_.u, nodes(Xi), nodes(U)); });
+  timed(timings_.interpolate, Phase::Interpolation, [&] { coupler_.interpolate_velocity(committed_.u, nodes(Xi), nodes(U)); });
 }
 
 void DistributedOperator::correct_positions(std::span<const Vec3> X) {
@@ -349,7 +338,7 @@ void DistributedOperator::move_to(std::span<const Vec3> X) {
   migrations_ += ownership_.migrate();
   refresh();
   U_.resize(X_.size());
-  timed(timings_.interpolate, Phase::Interpolation, [&] { points_.interpolate(coupler_, committed_.u, X_, U_); });
+  timed(timings_.interpolate, Phase::Interpolation, [&] { coupler_.interpolate_velocity(committed_.u, X_, U_); });
   trial_X_.clear();
   trial_done_ = false;
 }

@@ -8,11 +8,11 @@
 //   f(X)      membrane forces of the owned membranes    ElasticMembrane::compute_force (the object of the membrane's
 //                                                       global index; every process holds all of them)
 //             plus the contact forces                    ContactForce on the owned membranes and their neighbours
-//   S(X) f    spread into the slab force field          SlabIBCoupler::spread_force, through the coupling points
+//   S(X) f    spread into the slab force field          SlabIBCoupler::spread_force
 //   χ(X̄)      interior indicator, viscosity contrast     SlabViscosityIndicator::compute (X̄ = (X^n + Xf)/2, the
 //                                                       owned membranes' midpoints, as ImmersedBoundaryOperator)
 //   u^{n+1}   one step on the slabs                     SlabNavierStokesSolver::step
-//   J(X) u    interpolated back to the owned nodes      SlabIBCoupler::interpolate_velocity, through the points
+//   J(X) u    interpolated back to the owned nodes      SlabIBCoupler::interpolate_velocity
 //
 // Contact. A node's contact force sums its neighbours on other membranes within contact.range d. Each evaluation
 // all-gathers the bounding box of every membrane (ContactForce::bounds, from the positions of the evaluation); a
@@ -52,7 +52,6 @@
 #include "immerse/contact/ContactForce.hpp"
 #include "immerse/core/ThreadGovernor.hpp"
 #include "immerse/core/Vec3.hpp"
-#include "immerse/coupling/CouplingPoints.hpp"
 #include "immerse/coupling/SlabIBCoupler.hpp"
 #include "immerse/coupling/SlabViscosityIndicator.hpp"
 #include "immerse/fluid/FluidState.hpp"
@@ -71,13 +70,11 @@ class DistributedOperator final : public CoupledOperator {
   /// initial and reference positions (every process passes the same); `fluid_state` this process's slab state
   /// (SlabNavierStokesSolver::scatter); the membranes repel each other and the walls by `contact` (off by default);
   /// viscosity_ratio holds each membrane's λ = μ_in/μ_out (empty: all 1; any λ ≠ 1 needs a fluid solver with
-  /// variable viscosity); `coupling` the points through which each membrane meets the fluid, by global index (empty:
-  /// every node). `fluid` and `coupler` are kept by reference. Collective.
+  /// variable viscosity). `fluid` and `coupler` are kept by reference. Collective.
   DistributedOperator(SlabNavierStokesSolver& fluid, SlabIBCoupler& coupler,
                       std::vector<const ElasticMembrane*> membranes, std::span<const std::vector<Vec3>> X0,
                       std::span<const std::vector<Vec3>> reference, FluidState fluid_state,
-                      const ContactSettings& contact = {}, std::vector<double> viscosity_ratio = {},
-                      std::vector<CouplingPoints> coupling = {});
+                      const ContactSettings& contact = {}, std::vector<double> viscosity_ratio = {});
   DistributedOperator(const DistributedOperator&) = delete;  // its ownership refers to the fluid's decomposition
   DistributedOperator& operator=(const DistributedOperator&) = delete;
 
@@ -121,7 +118,7 @@ class DistributedOperator final : public CoupledOperator {
   static std::span<const double> flat(const std::vector<Vec3>& v) {
     return {reinterpret_cast<const double*>(v.data()), 3 * v.size()};
   }
-  /// X_, offset_ and points_ from the ownership's membranes.
+  /// X_ and offset_ from the ownership's membranes.
   void refresh();
   /// F = f(Xf) at the owned nodes: membrane forces, then the contact forces added. Collective.
   void nodal_forces(std::span<const Vec3> Xf);
@@ -167,8 +164,6 @@ class DistributedOperator final : public CoupledOperator {
   int migrations_ = 0;
   StepTimings timings_;
   ThreadGovernor governor_;
-  std::vector<CouplingPoints> membrane_points_;  ///< each membrane's coupling points, by global index
-  CouplingPoints points_;                        ///< the owned membranes' coupling points, concatenated
 };
 
 }  // namespace immerse

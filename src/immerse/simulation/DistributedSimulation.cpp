@@ -57,7 +57,7 @@ DistributedSimulation::DistributedSimulation(const io::Config& config, Communica
   op_ = std::make_unique<DistributedOperator>(
       fluid_, coupler_, std::move(ms), membranes_.initial, membranes_.references,
       fluid_.scatter(run_initial_fluid_state(config_, grid_, fluid_.params())), run_contact_settings(config_),
-      membranes_.viscosity_ratio, membranes_.coupling);
+      membranes_.viscosity_ratio);
   op_->set_thread_governor(threads_);
   integrator_ = make_integrator(config_.get<std::string>("time.scheme"), run_solver_settings(config_),
                                 comm.comm());
@@ -271,7 +271,7 @@ void DistributedSimulation::restore(const io::Checkpoint& ck) {
   for (const auto& m : membranes_.membranes) ms.push_back(m.get());
   op_ = std::make_unique<DistributedOperator>(fluid_, coupler_, std::move(ms), X, membranes_.references,
                                               fluid_.scatter(f), run_contact_settings(config_),
-                                              membranes_.viscosity_ratio, membranes_.coupling);
+                                              membranes_.viscosity_ratio);
   op_->set_thread_governor(threads_);
   integrator_->prepare(op_->size());
   // The history of the nodes this process now owns, in its order (each stored vector: all unknowns, global order).

@@ -50,15 +50,13 @@ void blend(const Grid& g, double theta, const FaceField& a, const FaceField& b, 
 ImmersedBoundaryOperator::ImmersedBoundaryOperator(NavierStokesSolver& fluid, IBCoupler& coupler,
                                                    std::vector<const ElasticMembrane*> membranes,
                                                    std::vector<std::vector<Vec3>> X0, FluidState fluid_state,
-                                                   const ContactSettings& contact, std::vector<double> viscosity_ratio,
-                                                   std::vector<CouplingPoints> coupling)
+                                                   const ContactSettings& contact, std::vector<double> viscosity_ratio)
     : fluid_(fluid),
       coupler_(coupler),
       membranes_(std::move(membranes)),
       committed_(std::move(fluid_state)),
       force_start_(fluid.grid()),
-      force_(fluid.grid()),
-      membrane_points_(std::move(coupling)) {
+      force_(fluid.grid()) {
   if (X0.size() != membranes_.size()) throw std::logic_error("ImmersedBoundaryOperator: one position array per membrane");
   for (std::size_t m = 0; m < membranes_.size(); ++m) {
     if (X0[m].size() != membranes_[m]->num_nodes())
@@ -69,15 +67,6 @@ ImmersedBoundaryOperator::ImmersedBoundaryOperator(NavierStokesSolver& fluid, IB
     Fm_.emplace_back(X0[m].size());
   }
   offset_.push_back(X_.size());
-  if (membrane_points_.empty())
-    for (std::size_t m = 0; m < membranes_.size(); ++m) membrane_points_.emplace_back(offset_[m + 1] - offset_[m]);
-  std::vector<const CouplingPoints*> parts;
-  for (std::size_t m = 0; m < membranes_.size(); ++m) {
-    if (membrane_points_.size() != membranes_.size() || membrane_points_[m].num_nodes() != offset_[m + 1] - offset_[m])
-      throw std::logic_error("ImmersedBoundaryOperator: one set of coupling points per membrane, on its nodes");
-    parts.push_back(&membrane_points_[m]);
-  }
-  points_ = CouplingPoints::concatenate(parts);
   F_.resize(X_.size());
   U_.resize(X_.size());
   applied_.assign(X_.size(), Vec3{});
@@ -97,7 +86,7 @@ ImmersedBoundaryOperator::ImmersedBoundaryOperator(NavierStokesSolver& fluid, IB
     for (std::size_t m = 0; m < membranes_.size(); ++m) Xmid_.emplace_back(X0[m].size());
   }
   membrane_force_density(X_, force_start_);
-  points_.interpolate(coupler_, committed_.u, X_, U_);
+  coupler_.interpolate_velocity(committed_.u, X_, U_);
 }
 
 void ImmersedBoundaryOperator::update_indicator(std::span<const Vec3> Xf) {
@@ -167,7 +156,7 @@ void ImmersedBoundaryOperator::membrane_force_density(std::span<const Vec3> X, F
 #pragma omp parallel for schedule(static) if (n >= kMinNodesForThreads)
       for (long i = 0; i < n; ++i) F_[static_cast<std::size_t>(i)] += contact_F_[static_cast<std::size_t>(i)];
     });
-  timed(timings_.spread, Phase::Spreading, [&] { points_.spread(coupler_, X, F_, f); });
+  timed(timings_.spread, Phase::Spreading, [&] { coupler_.spread_force(X, F_, f); });
 }
 
 template <class F>
@@ -202,7 +191,7 @@ void ImmersedBoundaryOperator::trial_velocity(std::span<const double> Xf, double
   governed([&] {
     const double occasional = trial_step(Xf, theta, dt);
     timed(timings_.interpolate, Phase::Interpolation, [&] {
-      points_.interpolate(coupler_, trial_.u, nodes(Xi), {reinterpret_cast<Vec3*>(U.data()), U.size() / 3});
+      coupler_.interpolate_velocity(trial_.u, nodes(Xi), {reinterpret_cast<Vec3*>(U.data()), U.size() / 3});
     });
     return occasional;
   });
@@ -217,7 +206,7 @@ void ImmersedBoundaryOperator::trial_mean_velocity(std::span<const double> Xf, s
     const double occasional = trial_step(Xf, 1.0, dt);
     timed(timings_.interpolate, Phase::Interpolation, [&] {
       blend(fluid_.grid(), 0.5, trial_.u, committed_.u, mean_);
-      points_.interpolate(coupler_, mean_, nodes(Xi), {reinterpret_cast<Vec3*>(U.data()), U.size() / 3});
+      coupler_.interpolate_velocity(mean_, nodes(Xi), {reinterpret_cast<Vec3*>(U.data()), U.size() / 3});
     });
     return occasional;
   });
@@ -226,7 +215,7 @@ void ImmersedBoundaryOperator::trial_mean_velocity(std::span<const double> Xf, s
 
 void ImmersedBoundaryOperator::committed_velocity(std::span<const double> Xi, std::span<double> U) {
   timed(timings_.interpolate, Phase::Interpolation, [&] {
-    points_.interpolate(coupler_, committed_.u, nodes(Xi), {reinterpret_cast<Vec3*>(U.data()), U.size() / 3});
+    coupler_.interpolate_velocity(committed_.u, nodes(Xi), {reinterpret_cast<Vec3*>(U.data()), U.size() / 3});
   });
 }
 
@@ -238,7 +227,7 @@ void ImmersedBoundaryOperator::commit(std::span<const double> X, double) {
   if (trial_U_valid_ && trial_matches(X))
     std::swap(U_, trial_U_);
   else
-    timed(timings_.interpolate, Phase::Interpolation, [&] { points_.interpolate(coupler_, committed_.u, X_, U_); });
+    timed(timings_.interpolate, Phase::Interpolation, [&] { coupler_.interpolate_velocity(committed_.u, X_, U_); });
   trial_U_valid_ = false;
   // An implicit step's last trial was driven by X^{n+1} itself: its S(X^{n+1}) f(X^{n+1}) is the next step's start.
   // Otherwise the start force is computed when a trial first needs it (never by the explicit schemes, theta = 1).
@@ -273,21 +262,12 @@ void ImmersedBoundaryOperator::correct_positions(std::size_t m, const std::vecto
   if (X.size() != n) throw std::logic_error("correct_positions: one position per node");
   std::copy(X.begin(), X.end(), X_.begin() + static_cast<std::ptrdiff_t>(offset_[m]));
   timed(timings_.interpolate, Phase::Interpolation, [&] {
-    membrane_points_[m].interpolate(coupler_, committed_.u, std::span<const Vec3>(X_).subspan(offset_[m], n),
-                                    std::span<Vec3>(U_).subspan(offset_[m], n));
+    coupler_.interpolate_velocity(committed_.u, std::span<const Vec3>(X_).subspan(offset_[m], n),
+                                  std::span<Vec3>(U_).subspan(offset_[m], n));
   });
   trial_X_.clear();
   trial_U_valid_ = false;
   start_valid_ = false;
-}
-
-void ImmersedBoundaryOperator::prepare_preconditioner(std::span<const double> X, double c) {
-  timed(timings_.preconditioner, Phase::PreconditionerSetup, [&] { preconditioner_->prepare(nodes(X), offset_, c); });
-}
-
-void ImmersedBoundaryOperator::apply_preconditioner(std::span<const double> v, std::span<double> z) {
-  timed(timings_.preconditioner, Phase::PreconditionerApply,
-        [&] { preconditioner_->apply(nodes(v), {reinterpret_cast<Vec3*>(z.data()), z.size() / 3}); });
 }
 
 double ImmersedBoundaryOperator::min_wall_distance() const { return immerse::min_wall_distance(fluid_.grid(), X_); }

@@ -4,11 +4,9 @@
 //   f(X)      membrane forces at the nodes           ElasticMembrane::compute_force  (§2.3, eq. 42 or -dE/dX)
 //             plus the contact forces                 ContactForce::compute (membrane-membrane, membrane-wall)
 //   S(X) f    spread to the MAC faces                 IBCoupler::spread_force          (eq. 6)
-//             through the coupling points              CouplingPoints::spread (S(X_c) Pᵀ f; every node by default)
 //   χ(X̄)      interior indicator, viscosity contrast  ViscosityIndicator::compute      (X̄ = (X^n + Xf)/2)
 //   u^{n+1}   one projection step driven by F^{n+1/2}  NavierStokesSolver::prepare, step (eqs. 9-13)
 //   J(X) u    interpolated back to the nodes          IBCoupler::interpolate_velocity  (eq. 14)
-//             through the coupling points              CouplingPoints::interpolate (P J(X_c) u)
 //
 // with F^{n+1/2} = (1 - theta) S(X^n) f(X^n) + theta S(Xf) f(Xf); S(X^n) f(X^n) is taken over from the last trial
 // when that was driven by X^{n+1} (as an implicit step's is), else computed once, when a trial with theta < 1
@@ -31,12 +29,10 @@
 
 #include "immerse/contact/ContactForce.hpp"
 #include "immerse/core/ThreadGovernor.hpp"
-#include "immerse/coupling/CouplingPoints.hpp"
 #include "immerse/coupling/IBCoupler.hpp"
 #include "immerse/coupling/ViscosityIndicator.hpp"
 #include "immerse/fluid/NavierStokesSolver.hpp"
 #include "immerse/membrane/ElasticMembrane.hpp"
-#include "immerse/simulation/CellPreconditioner.hpp"
 #include "immerse/simulation/StepTimings.hpp"
 #include "immerse/timestep/CoupledOperator.hpp"
 
@@ -46,12 +42,11 @@ class ImmersedBoundaryOperator final : public CoupledOperator {
  public:
   /// `membranes` and their initial positions X0 (one array per membrane); the fluid starts from `fluid_state`;
   /// the membranes repel each other and the walls by `contact` (off by default); viscosity_ratio holds each
-  /// membrane's λ = μ_in/μ_out (empty: all 1; any λ ≠ 1 needs a fluid solver with variable viscosity);
-  /// `coupling`: the points through which each membrane meets the fluid (empty: every node).
+  /// membrane's λ = μ_in/μ_out (empty: all 1; any λ ≠ 1 needs a fluid solver with variable viscosity).
   ImmersedBoundaryOperator(NavierStokesSolver& fluid, IBCoupler& coupler,
                            std::vector<const ElasticMembrane*> membranes, std::vector<std::vector<Vec3>> X0,
                            FluidState fluid_state, const ContactSettings& contact = {},
-                           std::vector<double> viscosity_ratio = {}, std::vector<CouplingPoints> coupling = {});
+                           std::vector<double> viscosity_ratio = {});
 
   std::size_t size() const override { return 3 * X_.size(); }
   std::span<const double> positions() const override { return flat(X_); }
@@ -67,11 +62,6 @@ class ImmersedBoundaryOperator final : public CoupledOperator {
   bool trial_matches(std::span<const double> X) const override { return std::ranges::equal(X, trial_X_); }
   void commit(std::span<const double> X, double dt) override;
   std::size_t fluid_solves() const override { return solves_; }
-  bool has_preconditioner() const override { return preconditioner_ != nullptr; }
-  void prepare_preconditioner(std::span<const double> X, double c) override;
-  void apply_preconditioner(std::span<const double> v, std::span<double> z) override;
-  /// Preconditions the implicit step by `p` (CellPreconditioner.hpp), one cell per membrane.
-  void set_preconditioner(std::shared_ptr<CellPreconditioner> p) { preconditioner_ = std::move(p); }
 
   const FluidState& fluid_state() const { return committed_; }
   /// Wall time spent so far in each part of the coupled step (since construction, which evaluates the forces once).
@@ -148,9 +138,6 @@ class ImmersedBoundaryOperator final : public CoupledOperator {
   std::size_t solves_ = 0;
   StepTimings timings_;
   ThreadGovernor governor_;
-  std::shared_ptr<CellPreconditioner> preconditioner_;  ///< none by default
-  std::vector<CouplingPoints> membrane_points_;  ///< each membrane's coupling points
-  CouplingPoints points_;                        ///< all membranes' coupling points, concatenated
 };
 
 static_assert(sizeof(Vec3) == 3 * sizeof(double), "positions are viewed as flat arrays of doubles");

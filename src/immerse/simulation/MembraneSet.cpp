@@ -104,13 +104,12 @@ class Builder {
     check_geometry();
     return {std::move(meshes_),           std::move(references_),      std::move(initial_),
             std::move(membranes_),        std::move(corrected_volume_), std::move(viscosity_ratio_),
-            std::move(coupling_),         std::move(packing_summary_)};
+            std::move(packing_summary_)};
   }
 
  private:
   void build_membranes();
-  void add_membrane(const io::Config& m, Mesh mesh, std::vector<Vec3> initial, std::vector<Vec3> reference,
-                    CouplingPoints coupling);
+  void add_membrane(const io::Config& m, Mesh mesh, std::vector<Vec3> initial, std::vector<Vec3> reference);
   void pack_membranes();
   void check_geometry() const;
 
@@ -122,7 +121,6 @@ class Builder {
   std::vector<std::unique_ptr<ElasticMembrane>> membranes_;
   std::vector<std::optional<double>> corrected_volume_;
   std::vector<double> viscosity_ratio_;
-  std::vector<CouplingPoints> coupling_;
   std::string packing_summary_;
 };
 
@@ -135,7 +133,6 @@ void Builder::build_membranes() {
       const int level = m.get<int>("mesh.level");
       Mesh mesh;
       std::vector<Vec3> initial, reference;
-      std::optional<CouplingPoints> coupling;
       if (family == "file") {
         // A user's mesh is the initial shape itself, its length unit times mesh.scale, placed by center and rotation;
         // its reference is the same shape, the reference sphere over the directions of its nodes (for star-shaped
@@ -170,30 +167,12 @@ void Builder::build_membranes() {
         }
       } else {
         mesh = family == "icosahedral" ? icosahedral_sphere(level) : octahedral_sphere(level);
-        const int coupling_level = m.get<int>("mesh.coupling_level");
-        if (coupling_level > level)
-          throw InputError("mesh.coupling_level = " + std::to_string(coupling_level) + ": must be at most mesh.level (" +
-                           std::to_string(level) + "), or -1 for every node");
-        if (coupling_level >= 0 && coupling_level < level)
-          coupling.emplace(mesh, family == "icosahedral" ? icosahedral_sphere(coupling_level)
-                                                         : octahedral_sphere(coupling_level));
         initial = map_sphere(shape_of(m, false), mesh.nodes);
         reference = map_sphere(shape_of(m, true), mesh.nodes);
-        // Through coarser points the nodes move with the points' quadratic interpolant (U = P U_c), so they start on
-        // it: X = P X_c. Nodes left on the shape itself would keep their offsets from the interpolant fixed in space
-        // while the membrane turns (a tank-treading capsule lost 1.3 % of its volume by k t = 6).
-        if (coupling) {
-          for (auto* X : {&initial, &reference}) {
-            std::vector<Vec3> Xc(coupling->num_points());
-            coupling->gather(*X, Xc);
-            coupling->prolong(Xc, *X);
-          }
-        }
       }
       mesh.nodes = initial;
       validate_closed_mesh(mesh, name);
-      if (!coupling) coupling.emplace(mesh.num_nodes());
-      add_membrane(m, std::move(mesh), std::move(initial), std::move(reference), std::move(*coupling));
+      add_membrane(m, std::move(mesh), std::move(initial), std::move(reference));
     } catch (const InputError& e) {
       // A key of the entry becomes membrane[i].key; the membrane's own "membrane reference element 3" becomes
       // "membrane[i] reference element 3".
@@ -203,8 +182,7 @@ void Builder::build_membranes() {
   }
 }
 
-void Builder::add_membrane(const io::Config& m, Mesh mesh, std::vector<Vec3> initial, std::vector<Vec3> reference,
-                           CouplingPoints coupling) {
+void Builder::add_membrane(const io::Config& m, Mesh mesh, std::vector<Vec3> initial, std::vector<Vec3> reference) {
   Bending bending{m.get<double>("kappa_B"), m.get<std::string>("bending_reference") == "rest"
                                                  ? ReferenceCurvature::RestShape
                                                  : ReferenceCurvature::Zero};
@@ -216,7 +194,6 @@ void Builder::add_membrane(const io::Config& m, Mesh mesh, std::vector<Vec3> ini
                                   ? std::optional<double>(volume(mesh, initial))
                                   : std::nullopt);
   viscosity_ratio_.push_back(m.get<double>("viscosity_ratio"));
-  coupling_.push_back(std::move(coupling));
   meshes_.push_back(std::move(mesh));
   references_.push_back(std::move(reference));
   initial_.push_back(std::move(initial));
@@ -245,7 +222,6 @@ void Builder::pack_membranes() {
       throw InputError(std::string("membrane[0].") + k + " = " + t.value_text(k) + ": does not apply with " + key +
                        " (the packer places and turns the copies)");
   const Mesh tmpl = meshes_[0];
-  const CouplingPoints tmpl_coupling = coupling_[0];
   const MembraneGeometry g = measure(tmpl, initial_[0]);
   std::vector<Vec3> shape, reference;
   for (const auto& p : initial_[0]) shape.push_back(p - g.centroid);
@@ -279,14 +255,13 @@ void Builder::pack_membranes() {
   membranes_.clear();
   corrected_volume_.clear();
   viscosity_ratio_.clear();
-  coupling_.clear();
   for (const auto& place : packing.placements()) {
     Mesh mesh = tmpl;
     std::vector<Vec3> X, R;
     for (const auto& p : shape) X.push_back(place.rotation * p + place.translation);
     for (const auto& p : reference) R.push_back(place.rotation * p + place.translation);
     mesh.nodes = X;
-    add_membrane(m, std::move(mesh), std::move(X), std::move(R), tmpl_coupling);
+    add_membrane(m, std::move(mesh), std::move(X), std::move(R));
   }
 }
 

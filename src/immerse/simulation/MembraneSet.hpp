@@ -17,7 +17,6 @@
 #include <vector>
 
 #include "immerse/core/Vec3.hpp"
-#include "immerse/coupling/CouplingPoints.hpp"
 #include "immerse/grid/Grid.hpp"
 #include "immerse/io/Config.hpp"
 #include "immerse/membrane/ElasticMembrane.hpp"
@@ -35,7 +34,6 @@ struct MembraneSet {
   /// The initial volume of each membrane whose volume is restored after every step (volume_correction).
   std::vector<std::optional<double>> corrected_volume;
   std::vector<double> viscosity_ratio;  ///< λ = μ_in/μ_out of each membrane
-  std::vector<CouplingPoints> coupling;  ///< the points through which each membrane meets the fluid
   /// "packing: N copies of membrane[0], volume fraction ..., in T s" when [packing] placed the membranes, else empty.
   std::string packing_summary;
 };

@@ -34,11 +34,6 @@ ConfigSchema membrane_schema() {
                "placed by center and rotation; shape, radius, semi_axes, aspect_ratio, inclination, R0 and mesh.level "
                "do not apply)");
   m.add_int("mesh.level", 3, Range::closed(0, 7), "subdivision level (icosahedral 4: 10,242 nodes; octahedral 5: 16,386)");
-  m.add_int("mesh.coupling_level", -1, Range::closed(-1, 7),
-            "the membrane meets the fluid (spreading, interpolation) through the nodes of the same family's mesh at "
-            "this lower level, a subset of its nodes: the node velocities are that coarser mesh's quadratic "
-            "interpolant of the points' velocities, the points carry the nodal forces gathered by the transposed "
-            "interpolation (src/immerse/coupling/CouplingPoints.hpp); -1 couples at every node (the paper's method)");
   m.add_path("mesh.file",
              "Gmsh .msh file of one closed surface when mesh.family = \"file\"; a relative name is taken from the "
              "configuration file's folder (given with --set: from the current folder); the run folder keeps a copy");
@@ -178,12 +173,6 @@ ConfigSchema run_schema() {
   s.add_string("solver.initial_guess", "recurrence", {"recurrence", "extrapolation"},
                "Newton's start: the linear extrapolation of §3 step 1 plus the error a recurrence fitted to the last "
                "steps' errors predicts (recurrence), or the extrapolation alone (extrapolation, the paper's)");
-  s.add_string("solver.preconditioner", "none", {"none", "cells"},
-               "time.scheme = jfnk: GMRES unpreconditioned (none, the paper's) or right-preconditioned per cell by "
-               "I + c M_c K_c on the cell's coarse points (cells: CellPreconditioner.hpp; generated meshes of level >= 2; "
-               "PETSc's PCSHELL, -pc_type none switches it off)");
-  s.add_int("solver.preconditioner_level", 1, Range::closed(0, 5),
-            "solver.preconditioner = cells: subdivision level of each cell's coarse points (1: 162 icosahedral points)");
   s.add_string("solver.petsc_options", "", {},
                "PETSc options of the implicit schemes' solver (jfnk: SNES, KSP, PC, MatMFFD; anderson, lbfgs: SNES) "
                "and of PETSc itself (-log_view, -options_left), e.g. \"-ksp_gmres_restart 50 -snes_converged_reason\"; "
@@ -220,8 +209,7 @@ std::string membrane_key_not_applying(const io::Config& m, const std::string& ke
   if (key == "shape" || key == "semi_axes" || key == "aspect_ratio" || key == "inclination" || key == "R0" ||
       (key == "radius" && !shear))
     return "does not apply to mesh.family = \"file\" (the file gives the shape; use mesh.scale)";
-  if (key == "mesh.level" || key == "mesh.coupling_level")
-    return "does not apply to mesh.family = \"file\" (the file gives the nodes)";
+  if (key == "mesh.level") return "does not apply to mesh.family = \"file\" (the file gives the nodes)";
   if (key == "reference_radius" && reference != "sphere") return "does not apply unless reference = \"sphere\"";
   if (key == "mesh.reference_file" && reference != "file") return "does not apply unless reference = \"file\"";
   return "";

@@ -28,22 +28,19 @@ Simulation::Simulation(const io::Config& config, const std::function<bool()>& st
       coupler_(grid_, delta_kernel(config.get<std::string>("coupling.kernel"))),
       stepper_(config.get<double>("time.dt"), config.get<double>("time.dt_min")) {
   MembraneSet set = build_membrane_set(config_, grid_, stop_requested);
-  preconditioner_ = run_cell_preconditioner(config_, set, grid_);
   meshes_ = std::move(set.meshes);
   references_ = std::move(set.references);
   initial_ = std::move(set.initial);
   membranes_ = std::move(set.membranes);
   corrected_volume_ = std::move(set.corrected_volume);
   viscosity_ratio_ = std::move(set.viscosity_ratio);
-  coupling_ = std::move(set.coupling);
   packing_summary_ = std::move(set.packing_summary);
   std::vector<const ElasticMembrane*> ms;
   for (auto& m : membranes_) ms.push_back(m.get());
   op_ = std::make_unique<ImmersedBoundaryOperator>(fluid_, coupler_, ms, initial_,
                                                    run_initial_fluid_state(config_, grid_, fluid_.params()),
-                                                   run_contact_settings(config), viscosity_ratio_, coupling_);
+                                                   run_contact_settings(config), viscosity_ratio_);
   op_->set_thread_governor(threads_);
-  op_->set_preconditioner(preconditioner_);
   integrator_ = make_integrator(config.get<std::string>("time.scheme"), run_solver_settings(config));
   if (integrator_->name() == "bfgs" && op_->size() > DenseBfgs::max_unknowns)
     throw InputError("time.scheme = \"bfgs\": the dense quasi-Newton matrix of eq. (35) is limited to " +
@@ -216,8 +213,7 @@ void Simulation::restore(const io::Checkpoint& ck) {
   std::vector<const ElasticMembrane*> ms;
   for (auto& m : membranes_) ms.push_back(m.get());
   op_ = std::make_unique<ImmersedBoundaryOperator>(fluid_, coupler_, ms, X, std::move(f), run_contact_settings(config_),
-                                                   viscosity_ratio_, coupling_);
-  op_->set_preconditioner(preconditioner_);
+                                                   viscosity_ratio_);
   integrator_->set_history(prev_X, prev_dt, guess_errors);
   stepper_.set_state(dt, static_cast<int>(successes));
   step_ = step;

@@ -103,8 +103,6 @@ class Simulation final : public SimulationInterface {
   /// The initial volume of each membrane whose volume is restored after every step (volume_correction).
   std::vector<std::optional<double>> corrected_volume_;
   std::vector<double> viscosity_ratio_;  ///< λ = μ_in/μ_out of each membrane
-  std::vector<CouplingPoints> coupling_;  ///< the points through which each membrane meets the fluid
-  std::shared_ptr<CellPreconditioner> preconditioner_;  ///< solver.preconditioner = "cells", else none
   std::unique_ptr<ImmersedBoundaryOperator> op_;
   std::unique_ptr<MembraneIntegrator> integrator_;
   AdaptiveStepper stepper_;

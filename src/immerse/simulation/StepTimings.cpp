@@ -11,14 +11,12 @@ std::string StepTimings::profile(double wall_seconds, long steps) const {
                                                   {"spreading", spread},
                                                   {"fluid", fluid},
                                                   {"interpolation", interpolate},
-                                                  {"preconditioner", preconditioner},
                                                   {"the rest", wall_seconds - total()}};
   std::string s = "ms per step (% of the wall time):";
   for (const auto& [name, seconds] : parts) {
-    if (name == parts[5].first && seconds == 0) continue;
     char buf[96];
     std::snprintf(buf, sizeof buf, " %s %.1f (%.0f %%)%s", name, 1e3 * seconds / double(steps),
-                  100 * seconds / wall_seconds, name == parts[6].first ? "" : ",");
+                  100 * seconds / wall_seconds, name == parts[5].first ? "" : ",");
     s += buf;
   }
   return s;

@@ -16,17 +16,15 @@ struct StepTimings {
   double spread = 0;       ///< S(X) f (eq. 6)
   double fluid = 0;        ///< the fluid step (eqs. 9-13) with its force F^{n+1/2}
   double interpolate = 0;  ///< J(X) u (eq. 14)
-  double preconditioner = 0;  ///< the implicit step's preconditioner, set up and applied (CellPreconditioner)
 
-  double total() const { return force + contact + spread + fluid + interpolate + preconditioner; }
+  double total() const { return force + contact + spread + fluid + interpolate; }
   /// The time spent between two readings `earlier` and *this of the same operator.
   StepTimings since(const StepTimings& earlier) const {
-    return {force - earlier.force,           contact - earlier.contact, spread - earlier.spread,
-            fluid - earlier.fluid,           interpolate - earlier.interpolate,
-            preconditioner - earlier.preconditioner};
+    return {force - earlier.force, contact - earlier.contact, spread - earlier.spread, fluid - earlier.fluid,
+            interpolate - earlier.interpolate};
   }
   /// One line: each part (and the rest of `wall_seconds`, the wall time of `steps` steps) in ms per step and in
-  /// per cent of the wall time (the preconditioner only when one was used).
+  /// per cent of the wall time.
   std::string profile(double wall_seconds, long steps) const;
 };
 

@@ -54,14 +54,6 @@ class CoupledOperator {
 
   /// Fluid steps performed so far (the unit of cost, notes: "fluid solves per step").
   virtual std::size_t fluid_solves() const = 0;
-
-  /// A preconditioner of the implicit residual's Jacobian I + c M K (c = θ² dt, M the mobility of one fluid step,
-  /// K = −∂f/∂X): whether there is one; prepared at the positions X; applied as z = P⁻¹ v. By default none.
-  virtual bool has_preconditioner() const { return false; }
-  virtual void prepare_preconditioner(std::span<const double> /*X*/, double /*c*/) {}
-  virtual void apply_preconditioner(std::span<const double> v, std::span<double> z) {
-    for (std::size_t i = 0; i < v.size(); ++i) z[i] = v[i];
-  }
 };
 
 }  // namespace immerse

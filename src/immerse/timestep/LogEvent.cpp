@@ -5,8 +5,8 @@
 namespace immerse {
 namespace {
 
-constexpr std::array<const char*, 8> kNames{"MembraneForces", "ContactForces", "Spreading",    "FluidStep",
-                                            "Interpolation",  "ImplicitResidual", "PCSetupCells", "PCApplyCells"};
+constexpr std::array<const char*, 6> kNames{"MembraneForces", "ContactForces", "Spreading", "FluidStep",
+                                            "Interpolation", "ImplicitResidual"};
 
 // Registered at the first event logged: logging is on only between PetscInitialize and PetscFinalize, and a process
 // initializes PETSc once (PetscSession).

@@ -13,8 +13,6 @@ enum class Phase {
   FluidStep,         ///< "FluidStep": the fluid step (eqs. 9-13)
   Interpolation,     ///< "Interpolation": J(X) u (eq. 14)
   ImplicitResidual,  ///< "ImplicitResidual": one evaluation of g(X) (eq. 31) by the nonlinear solver
-  PreconditionerSetup,  ///< "PCSetupCells": CellPreconditioner::prepare
-  PreconditionerApply,  ///< "PCApplyCells": CellPreconditioner::apply
 };
 
 class LogEvent {

@@ -27,7 +27,6 @@ struct SolverSettings {
   int anderson_memory = 5;      ///< Anderson acceleration: residual differences mixed (its depth m)
   double anderson_beta = 0.85;  ///< Anderson acceleration: the mixing (damping) parameter beta
   std::string petsc_options;    ///< extra PETSc options, e.g. "-ksp_gmres_restart 50"
-  std::string preconditioner = "none";  ///< jfnk: "none" or "cells" (the operator's, as PETSc's PCSHELL)
   InitialGuess initial_guess = InitialGuess::Recurrence;
   void validate() const;
 };

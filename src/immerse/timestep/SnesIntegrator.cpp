@@ -155,16 +155,7 @@ void SnesIntegrator::setup(std::size_t n) {
     IMMERSE_PETSC(KSPSetType(ksp, KSPGMRES));
     IMMERSE_PETSC(KSPSetTolerances(ksp, settings_.gmres_rtol, PETSC_DEFAULT, PETSC_DEFAULT, 200));
     IMMERSE_PETSC(KSPGetPC(ksp, &pc));
-    if (settings_.preconditioner == "cells") {  // right-preconditioned: GMRES's residual stays that of g
-      IMMERSE_PETSC(PCSetType(pc, PCSHELL));
-      IMMERSE_PETSC(PCShellSetContext(pc, this));
-      IMMERSE_PETSC(PCShellSetSetUp(pc, &SnesIntegrator::pc_setup));
-      IMMERSE_PETSC(PCShellSetApply(pc, &SnesIntegrator::pc_apply));
-      IMMERSE_PETSC(PCShellSetName(pc, "cells: I + c M_c K_c on each cell's coarse points"));
-      IMMERSE_PETSC(KSPSetPCSide(ksp, PC_RIGHT));
-    } else {
-      IMMERSE_PETSC(PCSetType(pc, PCNONE));  // the paper's GMRES is unpreconditioned
-    }
+    IMMERSE_PETSC(PCSetType(pc, PCNONE));  // the paper's GMRES is unpreconditioned
     IMMERSE_PETSC(KSPConvergedDefaultCreate(&ksp_default_ctx_));
     IMMERSE_PETSC(KSPSetConvergenceTest(ksp, &SnesIntegrator::gmres_converged, this, nullptr));
     IMMERSE_PETSC(PetscOptionsHasName(options_, nullptr, "-ksp_atol", &user_atol_));
@@ -249,51 +240,6 @@ PetscErrorCode SnesIntegrator::form_function(SNES, Vec x, Vec f, void* ctx) {
   for (long i = 0; i < n; ++i) fs[i] = g[i] / scale;
   PetscCall(VecRestoreArray(f, &fs));
   return 0;
-}
-
-// The preconditioner is prepared at the current Newton iterate (PETSc sets the PC up once per Jacobian, i.e. per
-// Newton step, or as -snes_lag_preconditioner says) with c = θ² dt.
-PetscErrorCode SnesIntegrator::pc_setup(PC pc) {
-  void* ctx = nullptr;
-  PetscCall(PCShellGetContext(pc, &ctx));
-  auto* self = static_cast<SnesIntegrator*>(ctx);
-  if (!self->residual_) return 0;  // SNESSetUp before the first step
-  Vec x;
-  PetscCall(SNESGetSolution(self->snes_, &x));
-  const PetscScalar* xs;
-  PetscCall(VecGetArrayRead(x, &xs));
-  std::vector<double> X(self->n_);
-  for (std::size_t i = 0; i < self->n_; ++i) X[i] = self->scale_ * xs[i];
-  PetscCall(VecRestoreArrayRead(x, &xs));
-  const double theta = self->settings_.theta;
-  try {
-    self->residual_->op().prepare_preconditioner(X, theta * theta * self->residual_->dt());
-  } catch (...) {
-    self->callback_error_ = std::current_exception();
-    return PETSC_ERR_USER;
-  }
-  return 0;
-}
-
-PetscErrorCode SnesIntegrator::pc_apply(PC pc, Vec v, Vec z) {
-  void* ctx = nullptr;
-  PetscCall(PCShellGetContext(pc, &ctx));
-  auto* self = static_cast<SnesIntegrator*>(ctx);
-  const PetscScalar* vs;
-  PetscScalar* zs;
-  PetscCall(VecGetArrayRead(v, &vs));
-  PetscCall(VecGetArray(z, &zs));
-  try {
-    if (self->residual_ && self->residual_->op().has_preconditioner())
-      self->residual_->op().apply_preconditioner({vs, self->n_}, {zs, self->n_});
-    else
-      std::copy(vs, vs + self->n_, zs);
-  } catch (...) {
-    self->callback_error_ = std::current_exception();
-  }
-  PetscCall(VecRestoreArray(z, &zs));
-  PetscCall(VecRestoreArrayRead(v, &vs));
-  return self->callback_error_ ? PETSC_ERR_USER : 0;
 }
 
 PetscErrorCode SnesIntegrator::converged(SNES snes, PetscInt it, PetscReal, PetscReal, PetscReal fnorm,

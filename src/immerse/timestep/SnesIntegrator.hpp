@@ -86,8 +86,6 @@ class SnesIntegrator final : public MembraneIntegrator {
   void check_options_used();
   void destroy();
   static PetscErrorCode form_function(SNES, Vec x, Vec f, void* ctx);
-  static PetscErrorCode pc_setup(PC pc);
-  static PetscErrorCode pc_apply(PC pc, Vec v, Vec z);
   static PetscErrorCode converged(SNES, PetscInt it, PetscReal xnorm, PetscReal snorm, PetscReal fnorm,
                                   SNESConvergedReason* reason, void* ctx);
   static PetscErrorCode gmres_converged(KSP ksp, PetscInt it, PetscReal rnorm, KSPConvergedReason* reason,
