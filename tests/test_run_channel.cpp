@@ -1,6 +1,7 @@
 // The rbc_channel scenario (§4.4, Fig. 15) on a coarse grid: 32 cells where Scenario.hpp says, every cell's
-// columns and mean_velocity in diagnostics.csv, the fluid starting in the discrete Poiseuille flow of the duct
-// (mean velocity = the series value up to O(h^2)), and the checks of its boundary layout.
+// columns and mean_velocity, flow_rate, pressure_drop and relative_viscosity in diagnostics.csv, the fluid starting
+// in the discrete Poiseuille flow of the duct (mean velocity = the series value up to O(h^2), relative viscosity 1),
+// and the checks of its boundary layout.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -26,10 +27,11 @@ TEST(RbcChannel, ThirtyTwoCellsInAPoiseuilleDuctWithTheirDiagnostics) {
   const auto rows = read_csv(dir / "out" / "diagnostics.csv");
   ASSERT_EQ(rows.size(), 4u);  // header, steps 0, 1, 2
   const auto& head = rows[0];
-  // The membranes' columns, mean_velocity, then the energy budget (4 fluid columns, 3 per cell, 2 totals).
+  // The membranes' columns, the duct's four, then the energy budget (4 fluid columns, 3 per cell, 2 totals).
   EXPECT_EQ(head[8u + 32u * 14u], "mean_velocity");
+  EXPECT_EQ(head[8u + 32u * 14u + 3u], "relative_viscosity");
   EXPECT_EQ(head.back(), "budget_residual");
-  EXPECT_EQ(head.size(), 8u + 32u * 14u + 1u + 4u + 32u * 3u + 2u);
+  EXPECT_EQ(head.size(), 8u + 32u * 14u + 4u + 4u + 32u * 3u + 2u);
   auto column = [&](const std::string& name) {
     const auto it = std::find(head.begin(), head.end(), name);
     EXPECT_NE(it, head.end()) << name;
@@ -58,6 +60,14 @@ TEST(RbcChannel, ThirtyTwoCellsInAPoiseuilleDuctWithTheirDiagnostics) {
   const DuctPoiseuille series{12e-6, 6e-6, 9e4, 4.1e-3};
   const double mean0 = std::stod(rows[1][column("mean_velocity")]), exact = series.flow_rate() / (24e-6 * 12e-6);
   EXPECT_NEAR(mean0 / exact, 1.0, 0.02) << mean0 << " vs " << exact;
+  // The flow rate through the 24 x 12 um section, the 9e4 Pa/m body force over the 48 um period, and the cell-free
+  // flow's own relative viscosity.
+  for (std::size_t row = 1; row < rows.size(); ++row) {
+    EXPECT_DOUBLE_EQ(std::stod(rows[row][column("flow_rate")]),
+                     std::stod(rows[row][column("mean_velocity")]) * 24e-6 * 12e-6);
+    EXPECT_DOUBLE_EQ(std::stod(rows[row][column("pressure_drop")]), 9e4 * 48e-6);
+  }
+  EXPECT_NEAR(std::stod(rows[1][column("relative_viscosity")]), 1.0, 1e-12);
   // The body force drives the flow (no wall moves) and the fluid dissipates what it puts in, nearly all of it in the
   // Poiseuille flow of step 0 (steady for the cell-free fluid).
   EXPECT_EQ(std::stod(rows[1][column("P_walls")]), 0.0);
@@ -67,6 +77,8 @@ TEST(RbcChannel, ThirtyTwoCellsInAPoiseuilleDuctWithTheirDiagnostics) {
   // The cells are carried downstream (+y) and add dissipation: the mean flow slows.
   EXPECT_GT(std::stod(rows[3][cell(12, "cy")]), centres[12].y);
   EXPECT_LT(std::stod(rows[3][column("mean_velocity")]), mean0);
+  const double mean2 = std::stod(rows[3][column("mean_velocity")]);
+  EXPECT_DOUBLE_EQ(std::stod(rows[3][column("relative_viscosity")]), mean0 / mean2);
 }
 
 TEST(RbcChannel, NeedsWallsAtXAndZAndAPeriodicY) {
