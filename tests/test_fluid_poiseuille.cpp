@@ -66,6 +66,20 @@ TEST(PoiseuilleFlow, MeanVelocityConvergesAtSecondOrderToTheSeries) {
   EXPECT_GE(verify::min_observed_order(errors), 1.9) << errors[0] << " " << errors[1] << " " << errors[2];
 }
 
+// The mean velocity along the flow, taken on a section two cells long, is that of the whole duct, 40 cells long.
+TEST(PoiseuilleFlow, MeanVelocityOfTheSectionIsThatOfTheDuct) {
+  const FluidParams prm = driven(2.5);
+  const Grid g({16, 40, 8}, {2.0, 5.0, 1.0}, {W, P, W}, {-1.0, 0.0, -0.5});
+  FaceField u(g);
+  set_poiseuille_flow(g, prm, u);
+  double sum = 0;
+  for (double v : u[1].values()) sum += v;
+  const double whole = sum / double(u[1].values().size());
+  EXPECT_GT(whole, 0.01);
+  EXPECT_NEAR(poiseuille_mean_velocity(g, prm, 1), whole, 1e-13 * whole);
+  EXPECT_EQ(poiseuille_mean_velocity(g, prm, 0), 0.0);
+}
+
 TEST(PoiseuilleFlow, RejectsMovingWallsForcesAcrossWallsAndBoxesWithoutWalls) {
   const Grid g = duct(4);
   FaceField u(g);

@@ -18,4 +18,9 @@ namespace immerse {
 /// boundary.*_velocity or fluid.initial) unless there is a wall axis, all walls rest and f is zero along wall axes.
 void set_poiseuille_flow(const Grid& grid, const FluidParams& params, FaceField& u);
 
+/// The mean of u along `axis` over the box in that flow (the faces as FaceField holds them, as the runs' mean_velocity
+/// takes it), computed on a box two cells long along every periodic axis: the flow does not depend on those
+/// coordinates. The same InputErrors as set_poiseuille_flow.
+double poiseuille_mean_velocity(const Grid& grid, const FluidParams& params, int axis);
+
 }  // namespace immerse

@@ -21,22 +21,13 @@ std::vector<Column> ChannelRun::run_columns() const {
 const ChannelRun::Duct& ChannelRun::duct(const SimulationInterface& sim) const {
   if (duct_) return *duct_;
   const Grid& grid = sim.grid();
-  const FluidParams params = run_fluid_params(sim.config());
-  Duct d{grid.length(0) * grid.length(2), grid.length(1), params.body_force[1],
-         std::numeric_limits<double>::quiet_NaN()};
-  if (d.force != 0) {
-    try {
-      // The cell-free flow does not depend on y: a box two cells long has its cross-section.
-      const Grid section({grid.n(0), 2, grid.n(2)}, {grid.length(0), 2 * grid.h(), grid.length(2)},
-                         {grid.bc(0), grid.bc(1), grid.bc(2)}, grid.origin());
-      FaceField u(section);
-      set_poiseuille_flow(section, params, u);
-      double sum = 0;
-      for (const double v : u[1].values()) sum += v;
-      d.cell_free = sum / static_cast<double>(u[1].values().size());
-    } catch (const InputError&) {
-      // A moving wall: no cell-free flow under the body force alone.
-    }
+  FluidParams unit = run_fluid_params(sim.config());
+  Duct d{grid.length(0) * grid.length(2), grid.length(1), unit.body_force[1], std::numeric_limits<double>::quiet_NaN()};
+  unit.body_force = {0, 1, 0};
+  try {
+    d.cell_free = poiseuille_mean_velocity(grid, unit, 1);
+  } catch (const InputError&) {
+    // A moving wall: no cell-free flow under the body force alone.
   }
   return duct_.emplace(d);
 }
@@ -49,7 +40,7 @@ void ChannelRun::add_run_values(const SimulationInterface& sim, std::vector<doub
   row.push_back(U);
   row.push_back(U * d.section);
   row.push_back(d.force * d.period);
-  row.push_back(d.cell_free / U);
+  row.push_back(d.force != 0 ? d.cell_free * d.force / U : std::numeric_limits<double>::quiet_NaN());
 }
 
 }  // namespace immerse

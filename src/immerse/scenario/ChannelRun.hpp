@@ -25,7 +25,7 @@ class ChannelRun : public CellScenarioRun {
     double section = 0;    ///< Lx Lz (m^2)
     double period = 0;     ///< Ly (m)
     double force = 0;      ///< fluid.body_force along y (N/m^3)
-    double cell_free = 0;  ///< U_0 (m/s); NaN when a wall moves or nothing drives the flow
+    double cell_free = 0;  ///< U_0 per unit body force along y (m^4/(N s)); NaN when a wall moves
   };
   /// The duct of `sim`'s configuration, computed at the first row.
   const Duct& duct(const SimulationInterface& sim) const;
