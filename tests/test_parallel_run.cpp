@@ -201,6 +201,11 @@ TEST(ParallelRun, RedCellChannelRk2EqualsTheOneProcessRun) { compare_with_serial
 
 TEST(ParallelRun, RedCellChannelEulerEqualsTheOneProcessRun) { compare_with_serial("euler", kEulerSteps); }
 
+// The flow rate held by the force each step adds (fluid.flow_rate): its mean over the slabs, summed over the processes.
+TEST(ParallelRun, RedCellChannelAtAFlowRateEqualsTheOneProcessRun) {
+  compare_with_serial("rk2", kEulerSteps, {"fluid.flow_rate=[0,6e-14,0]"});
+}
+
 // Contact between the layers of cells: with a range of 1.5 um (3 h) the nodes of the cells of neighbouring layers,
 // owned by different processes on 2, 3 and 4 processes, and those of the outer layers and the walls repel each other
 // from the first step on.

@@ -82,6 +82,12 @@ TEST(RestartVolume, HalfRunPlusRestartEqualsOneRunBitwiseWithVolumeConstraintAnd
                                     "membrane[0].area_modulus=0.1"});
 }
 
+// A flow rate held along x (fluid.flow_rate): the force each step adds is in the checkpoint, and the energy budget
+// continues with it.
+TEST(RestartFlowRate, HalfRunPlusRestartEqualsOneRunBitwiseAtAFlowRate) {
+  expect_restart_bitwise("jfnk", {"boundary.x=\"periodic\"", "fluid.flow_rate=[0.002,0,0]"});
+}
+
 INSTANTIATE_TEST_SUITE_P(Run, RestartTest, ::testing::Values("jfnk", "lbfgs", "bfgs", "euler", "rk2", "anderson"),
                          [](const auto& p) { return p.param; });
 

@@ -4,6 +4,7 @@
 #include <string>
 
 #include "immerse/core/Error.hpp"
+#include "immerse/fluid/FluidState.hpp"
 
 namespace immerse {
 
@@ -13,6 +14,9 @@ void FluidParams::validate(const Grid& grid) const {
   require(std::isfinite(implicit_ratio) && implicit_ratio >= 1, "implicit viscosity ratio", implicit_ratio, ">= 1");
   for (int d = 0; d < 3; ++d)
     require(std::isfinite(body_force[d]), std::string("fluid.body_force.") + axis_name(d), body_force[d], "finite");
+  if (flow_axis >= 0)
+    require(grid.periodic(flow_axis), std::string("fluid.flow_rate.") + axis_name(flow_axis),
+            std::string("zero: a flow rate is held along a periodic axis, and ") + axis_name(flow_axis) + " has walls");
   for (int a = 0; a < 3; ++a) {
     if (grid.periodic(a)) continue;
     for (int d = 0; d < 3; ++d) {
@@ -25,6 +29,12 @@ void FluidParams::validate(const Grid& grid) const {
             std::string("fluid.wall_velocity.") + axis_name(a) + "_upper." + axis_name(a), wall_upper[a][a],
             "equal to the lower wall's normal velocity (zero net flux through the walls)");
   }
+}
+
+FluidParams step_params(const FluidParams& params, const FluidState& state) {
+  FluidParams p = params;
+  if (p.flow_axis >= 0) p.body_force[p.flow_axis] += state.flow_force;
+  return p;
 }
 
 }  // namespace immerse

@@ -28,11 +28,20 @@ struct FluidParams {
   /// constant-viscosity step of the paper.
   bool variable_viscosity = false;
   double implicit_ratio = 1.0;
+  /// fluid.flow_rate: every step ends at the mean velocity flow_mean_velocity along the periodic axis flow_axis (−1:
+  /// off), by the uniform body force it adds along that axis (NavierStokesSolver.hpp, "Flow rate").
+  int flow_axis = -1;
+  double flow_mean_velocity = 0;
 
   /// Throws a one-line InputError unless rho, mu > 0 and finite, the body force and wall velocities are finite,
   /// and on every wall axis the normal wall velocity is the same at both walls (zero net flux through the
-  /// boundary: the pressure Neumann problem (11) is then solvable), and implicit_ratio ≥ 1 and finite.
+  /// boundary: the pressure Neumann problem (11) is then solvable), implicit_ratio ≥ 1 and finite, and the flow axis
+  /// (if any) periodic.
   void validate(const Grid& grid) const;
 };
+
+struct FluidState;
+/// `params` with the body force of the step that reached `state`: fluid.flow_rate's added force included.
+FluidParams step_params(const FluidParams& params, const FluidState& state);
 
 }  // namespace immerse

@@ -17,6 +17,9 @@ struct FluidState {
   double dt_prev2 = 0; ///< the step before it, which produced p^{n-3/2} (0 before the second step)
   long step = 0;       ///< number of steps taken
   double time = 0;     ///< t^n
+  /// With fluid.flow_rate: the body force that the step which produced this state added along the flow axis to end
+  /// at the flow rate (N/m^3); 0 otherwise.
+  double flow_force = 0;
   /// Which prepared step's (u·∇_h u)^n `adv` holds (NavierStokesSolver::step(prepared, …) sets it and then skips
   /// copying it again into this state; 0: none). Whoever else writes `adv` in place sets it to 0.
   std::uint64_t adv_of = 0;

@@ -143,6 +143,7 @@ void NavierStokesSolver::advance(const FluidState& in, double dt, const Array3& 
       project_and_update_row<mac::Strided>(g, ustar_, phi_, div_, p, in.p, out, j, k, dt_rho, half_mu);
   });
   apply_wall_values(out.u);
+  if (params_.flow_axis >= 0) hold_flow_rate(dt, out);
   if (params_.variable_viscosity) {
     ensure_shape(out.u_prev, grid_);
     for (int d = 0; d < 3; ++d) out.u_prev[d].values() = in.u[d].values();
@@ -152,6 +153,30 @@ void NavierStokesSolver::advance(const FluidState& in, double dt, const Array3& 
   out.dt_prev = dt;
   out.step = in.step + 1;
   out.time = in.time + dt;
+}
+
+// The step is linear in the body force (the advection term and the pressure are of the state before it): adding ΔG
+// along the flow axis adds ΔG w, w = (I − c ∇_h²)⁻¹ Δt/ρ (divergence-free, as it does not vary along the axis).
+void NavierStokesSolver::hold_flow_rate(double dt, FluidState& out) {
+  const int a = params_.flow_axis;
+  const auto mean = [](const std::vector<double>& v) {
+    double s = 0;
+    for (const double x : v) s += x;
+    return s / static_cast<double>(v.size());
+  };
+  if (flow_response_dt_ != dt) {
+    Array3& w = ustar_[a];  // free again after the projection
+    std::fill(w.values().begin(), w.values().end(), dt / params_.rho);
+    solvers_[a]->solve(w, 1.0, -mu_implicit_ * dt / (2.0 * params_.rho));
+    flow_response_ = w;
+    flow_response_mean_ = mean(w.values());
+    flow_response_dt_ = dt;
+  }
+  std::vector<double>& u = out.u[a].values();
+  const double G = (params_.flow_mean_velocity - mean(u)) / flow_response_mean_;
+  const std::vector<double>& w = flow_response_.values();
+  for (std::size_t i = 0; i < u.size(); ++i) u[i] += G * w[i];
+  out.flow_force = G;
 }
 
 void NavierStokesSolver::step(const FluidState& in, const FaceField& force, double dt, FluidState& out,

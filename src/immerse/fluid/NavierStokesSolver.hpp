@@ -32,6 +32,16 @@
 // Both paths evaluate the same pointwise functions, the sums of u^n + (Δt/ρ)(−ρ A − G p + (μ/2) ∇_h² u^n + F +
 // f_body) taken left to right, so the split step is bitwise the one-pass one.
 //
+// Flow rate (FluidParams::flow_axis, fluid.flow_rate). The step is linear in the body force, the advection term and
+// the pressure being those of the state before it: a uniform ΔG added along the flow axis a adds ΔG w to u_a^{n+1},
+//   w = (I − (μΔt/2ρ) ∇_h²)⁻¹ Δt/ρ
+// (one fast solve per step size; D w = 0 since w does not vary along a periodic a, so the projection leaves it). After
+// (12) each step adds ΔG w with ΔG = (U* − ⟨u_a^{n+1}⟩)/⟨w⟩, ⟨·⟩ the mean over the box: the step that ends at the mean
+// velocity U* under the body force f_body + ΔG, exactly, whatever the membranes do (the constant flow rate of channel-
+// flow codes). ΔG goes into the new state (FluidState::flow_force) for the diagnostics and the energy budget.
+// Verified by the tests RbcChannel.FlowRateIsHeldWhileThePressureDropRises, RestartFlowRate.* and
+// ParallelRun.RedCellChannelAtAFlowRateEqualsTheOneProcessRun.
+//
 // Variable viscosity (FluidParams::variable_viscosity; docs/viscosity-contrast.md). With μ(x) = μ (1 + χ(x)) the
 // viscous term of (9) is ½[∇_h·(μ(∇_h u* + ∇_h u*ᵀ)) + ∇_h·(μ(∇_h u^n + ∇_h u^nᵀ))]. The fast solvers invert only
 // the constant part: with μ_p = implicit_ratio · μ ≥ max μ(x) and L_μ the stress operator, (9) takes
@@ -146,6 +156,13 @@ class NavierStokesSolver {
   template <class Rhs>
   void advance(const FluidState& in, double dt, const Array3& p, FluidState& out, Rhs&& rhs);
 
+  /// fluid.flow_rate ("Flow rate" above): adds ΔG w to the flow axis's velocity of `out`, w the step's response to a
+  /// unit body force along it (cached for the step size), so that its mean is FluidParams::flow_mean_velocity;
+  /// out.flow_force = ΔG.
+  void hold_flow_rate(double dt, FluidState& out);
+  Array3 flow_response_;          // w, for steps of flow_response_dt_
+  double flow_response_dt_ = 0;
+  double flow_response_mean_ = 0;  // its mean over the box
   /// Adds (Δt/ρ) μ ∇_h·(χ S(ũ)) to the right-hand side u* of (9) where χ is not zero.
   /// Component d of it, over the box of faces where it may not vanish (variable_stress_box).
   void add_variable_stress(const FaceField& utilde, const Array3& chi, double dt, int d, const IndexBox& box);

@@ -188,6 +188,7 @@ void SlabNavierStokesSolver::step(const FluidState& in, const FaceField& force, 
   if (variable)
     for (int d = 0; d < 3; ++d) out.u_prev[d] = in.u[d];  // with its ghosts
   apply_wall_values(out.u);
+  if (params_.flow_axis >= 0) hold_flow_rate(dt, out);
   for (int d = 0; d < 3; ++d) halo_.exchange(out.u[d], velocity_layout(d));
   halo_.exchange(out.p, Layout::Pressure);
 
@@ -195,6 +196,34 @@ void SlabNavierStokesSolver::step(const FluidState& in, const FaceField& force, 
   out.dt_prev = dt;
   out.step = in.step + 1;
   out.time = in.time + dt;
+}
+
+// As NavierStokesSolver::hold_flow_rate, the means summed over the planes each process holds.
+void SlabNavierStokesSolver::hold_flow_rate(double dt, FluidState& out) {
+  const int a = params_.flow_axis;
+  const Layout layout = velocity_layout(a);
+  const PlaneRange held = slabs_.held(layout);
+  const auto mean = [&](const Array3& v) {
+    const std::size_t plane = static_cast<std::size_t>(v.nx()) * v.ny();
+    const double* p = v.data() + v.index(0, 0, held.begin - slabs_.offset());
+    double s = 0;
+    for (std::size_t q = 0; q < plane * held.count(); ++q) s += p[q];
+    const auto shape = grid_.face_shape(a);
+    return slabs_.communicator().sum(s) / (double(shape[0]) * shape[1] * shape[2]);
+  };
+  if (flow_response_dt_ != dt) {
+    Array3& w = ustar_[a];  // free again after the projection
+    std::fill(w.values().begin(), w.values().end(), dt / params_.rho);
+    solvers_[a]->solve(w, slabs_.owned(layout).begin - slabs_.offset(), 1.0, -mu_implicit_ * dt / (2.0 * params_.rho));
+    flow_response_ = w;
+    flow_response_mean_ = mean(w);
+    flow_response_dt_ = dt;
+  }
+  const double G = (params_.flow_mean_velocity - mean(out.u[a])) / flow_response_mean_;
+  std::vector<double>& u = out.u[a].values();
+  const std::vector<double>& w = flow_response_.values();
+  for (std::size_t i = 0; i < u.size(); ++i) u[i] += G * w[i];
+  out.flow_force = G;
 }
 
 void SlabNavierStokesSolver::prepare_variable(const FluidState& in, double dt) {
@@ -282,6 +311,7 @@ FluidState SlabNavierStokesSolver::scatter(const FluidState& global) const {
   s.dt_prev2 = global.dt_prev2;
   s.step = global.step;
   s.time = global.time;
+  s.flow_force = global.flow_force;
   exchange_ghosts(s);
   return s;
 }
@@ -303,6 +333,7 @@ FluidState SlabNavierStokesSolver::gather(const FluidState& local) const {
   s.dt_prev2 = local.dt_prev2;
   s.step = local.step;
   s.time = local.time;
+  s.flow_force = local.flow_force;
   return s;
 }
 

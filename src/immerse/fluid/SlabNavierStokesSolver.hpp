@@ -100,6 +100,13 @@ class SlabNavierStokesSolver {
 
   Grid grid_;
   FluidParams params_;
+  /// fluid.flow_rate ("Flow rate" above): adds ΔG w to the flow axis's velocity of `out`, w the step's response to a
+  /// unit body force along it (cached for the step size), so that its mean (over all processes) is FluidParams::flow_mean_velocity;
+  /// out.flow_force = ΔG.
+  void hold_flow_rate(double dt, FluidState& out);
+  Array3 flow_response_;          // w, for steps of flow_response_dt_
+  double flow_response_dt_ = 0;
+  double flow_response_mean_ = 0;  // its mean over the box
   SlabDecomposition slabs_;
   HaloExchange halo_;
   MacStencilGrid geom_;   // the whole grid: wall sources and the loops' x and y ranges

@@ -22,7 +22,7 @@ const ChannelRun::Duct& ChannelRun::duct(const SimulationInterface& sim) const {
   if (duct_) return *duct_;
   const Grid& grid = sim.grid();
   FluidParams unit = run_fluid_params(sim.config());
-  Duct d{grid.length(0) * grid.length(2), grid.length(1), unit.body_force[1], std::numeric_limits<double>::quiet_NaN()};
+  Duct d{grid.length(0) * grid.length(2), grid.length(1), std::numeric_limits<double>::quiet_NaN()};
   unit.body_force = {0, 1, 0};
   try {
     d.cell_free = poiseuille_mean_velocity(grid, unit, 1);
@@ -39,8 +39,9 @@ void ChannelRun::add_run_values(const SimulationInterface& sim, std::vector<doub
   const double U = sim.mean_velocity(1);
   row.push_back(U);
   row.push_back(U * d.section);
-  row.push_back(d.force * d.period);
-  row.push_back(d.force != 0 ? d.cell_free * d.force / U : std::numeric_limits<double>::quiet_NaN());
+  const double G = sim.step_body_force()[1];
+  row.push_back(G * d.period);
+  row.push_back(G != 0 ? d.cell_free * G / U : std::numeric_limits<double>::quiet_NaN());
 }
 
 }  // namespace immerse

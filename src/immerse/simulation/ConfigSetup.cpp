@@ -59,6 +59,20 @@ FluidParams run_fluid_params(const io::Config& c) {
     p.wall_lower[d] = c.get<Vec3>(std::string("boundary.") + axis_name(d) + "_lower_velocity");
     p.wall_upper[d] = c.get<Vec3>(std::string("boundary.") + axis_name(d) + "_upper_velocity");
   }
+  // fluid.flow_rate: along one axis, through the box's cross-section normal to it.
+  const Vec3 Q = c.get<Vec3>("fluid.flow_rate");
+  int along = 0;
+  for (int d = 0; d < 3; ++d)
+    if (Q[d] != 0) p.flow_axis = d, ++along;
+  if (along > 1)
+    throw InputError("fluid.flow_rate = " + c.value_text("fluid.flow_rate") +
+                     ": must be zero but along one axis, the axis of the flow");
+  if (p.flow_axis >= 0) {
+    double section = 1;
+    for (int d = 0; d < 3; ++d)
+      if (d != p.flow_axis) section *= c.get<double>(std::string("domain.L") + axis_name(d));
+    p.flow_mean_velocity = Q[p.flow_axis] / section;
+  }
   return p;
 }
 

@@ -69,10 +69,11 @@ FluidEnergy DistributedSimulation::fluid_energy() const {
   const SlabDecomposition& slabs = fluid_.decomposition();
   const Array3& chi = op_->viscosity_indicator();
   const PlaneRange cells = slabs.cells();
-  const std::vector<double> mine =
-      fluid_energy_planes(grid_, fluid_.params(), op_->fluid_state().u, chi.size() > 0 ? &chi : nullptr, cells.begin,
-                          cells.end, slabs.offset());
-  return fluid_energy_total(grid_, fluid_.params(), slabs.communicator().sum(mine));
+  const FluidParams params = step_params(fluid_.params(), op_->fluid_state());
+  const std::vector<double> mine = fluid_energy_planes(grid_, params, op_->fluid_state().u,
+                                                       chi.size() > 0 ? &chi : nullptr, cells.begin, cells.end,
+                                                       slabs.offset());
+  return fluid_energy_total(grid_, params, slabs.communicator().sum(mine));
 }
 
 std::vector<MembraneEnergy> DistributedSimulation::membrane_energies() const {
@@ -113,6 +114,11 @@ StepRecord DistributedSimulation::advance(const Log& log, const StopQuery& stop_
   where.precision(10);
   where << "step " << step_ + 1 << ", t = " << time() << ": ";
   const int migrated = op_->migrations();
+  // fluid.flow_rate: the step's body work is taken with the step's own added force at both of its ends.
+  const int flow_axis = fluid_.params().flow_axis;
+  const double flow_momentum =
+      flow_axis >= 0 ? mean_velocity(flow_axis) * grid_.length(0) * grid_.length(1) * grid_.length(2) : 0.0;
+  const double flow_force = op_->fluid_state().flow_force;
   StepRecord r;
   try {
     const auto acc = stepper_.advance(
@@ -137,6 +143,7 @@ StepRecord DistributedSimulation::advance(const Log& log, const StopQuery& stop_
   r.step = step_;
   r.time = time();
   check_stability();
+  if (flow_axis >= 0) budget_.add_body_power((op_->fluid_state().flow_force - flow_force) * flow_momentum);
   budget_.advance(r.dt, fluid_energy());
   r.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return r;
@@ -235,6 +242,7 @@ void DistributedSimulation::restore(const io::Checkpoint& ck) {
   }
   f.step = entries.count("fluid.step");
   f.time = entries.time_value("fluid.time");
+  if (ck.has("fluid.flow_force")) f.flow_force = ck.get_double("fluid.flow_force");
   const std::size_t M = num_membranes();
   std::vector<std::vector<Vec3>> X(M);
   std::vector<std::size_t> first(M + 1, 0);  // of each membrane's unknowns in the global concatenation
@@ -345,6 +353,7 @@ void DistributedSimulation::write_checkpoint(const std::filesystem::path& file, 
   put_field("fluid.p_prev", f.p_prev, Layout::Pressure);
   ck.put_double("fluid.dt_prev", f.dt_prev);
   ck.put_double("fluid.dt_prev2", f.dt_prev2);
+  if (f.flow_force != 0) ck.put_double("fluid.flow_force", f.flow_force);  // with fluid.flow_rate
   ck.put_int("fluid.step", f.step);
   ck.put_double("fluid.time", f.time);
   const auto& owned = sim.op().ownership().owned();

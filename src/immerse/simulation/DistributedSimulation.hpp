@@ -117,6 +117,8 @@ class DistributedSimulation final : public SimulationInterface {
   double min_wall_distance() const override;
   /// Each process sums its planes; the sums are added in rank order.
   double mean_velocity(int d) const override;
+  const FluidParams& fluid_params() const override { return fluid_.params(); }
+  const FluidState& committed_fluid() const override { return op_->fluid_state(); }
   /// From the slab holding the cell plane next to the wall.
   double wall_shear_stress(bool upper, double mu, double wall_velocity_x) const override;
   StepTimings timings() const override { return op_->timings(); }

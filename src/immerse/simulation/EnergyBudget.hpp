@@ -38,6 +38,9 @@ class EnergyBudget {
   void start(double total, const FluidEnergy& fluid);
   /// After an accepted step of size dt that reached a state of fluid measures `fluid`.
   void advance(double dt, const FluidEnergy& fluid);
+  /// Adds `extra` (W) to the last state's body power before the step from it is advanced: with fluid.flow_rate each
+  /// step adds its own force, and the trapezoidal rule takes the power at both ends with the force of the step.
+  void add_body_power(double extra) { fluid_.body += extra; }
 
   /// The fluid measures at the last state.
   const FluidEnergy& fluid() const { return fluid_; }

@@ -124,6 +124,10 @@ ConfigSchema run_schema() {
   s.add_double("fluid.rho", 1000.0, Range::positive(), "density (kg/m^3)");
   s.add_double("fluid.mu", 1e-3, Range::positive(), "dynamic viscosity (Pa s)");
   s.add_vec3("fluid.body_force", {0, 0, 0}, Range::any(), "uniform body force, a mean pressure gradient (N/m^3)");
+  s.add_vec3("fluid.flow_rate", {0, 0, 0}, Range::any(),
+             "volume flow rate through the box's cross-section (m^3/s) along one periodic axis, held exactly at every "
+             "step by a uniform body force added along it to fluid.body_force (the step's response to a unit body "
+             "force, scaled; the diagnostics' pressure_drop and P_body include it); 0 switches it off");
   s.add_string("fluid.initial", "rest", {"rest", "couette", "poiseuille"},
                "initial velocity: at rest, the linear (Couette) profile between the moving walls, or the steady "
                "flow driven by fluid.body_force between resting walls (the discrete Poiseuille solution)");

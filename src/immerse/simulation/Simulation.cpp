@@ -52,7 +52,8 @@ Simulation::Simulation(const io::Config& config, const std::function<bool()>& st
 
 FluidEnergy Simulation::fluid_energy() const {
   const Array3& chi = op_->viscosity_indicator();
-  return immerse::fluid_energy(grid_, fluid_.params(), op_->fluid_state().u, chi.size() > 0 ? &chi : nullptr);
+  return immerse::fluid_energy(grid_, step_params(fluid_.params(), op_->fluid_state()), op_->fluid_state().u,
+                               chi.size() > 0 ? &chi : nullptr);
 }
 
 MembraneEnergy Simulation::membrane_energy(std::size_t m) const {
@@ -70,6 +71,11 @@ bool Simulation::finished() const { return time() >= end_time_ * (1 - 1e-12); }
 StepRecord Simulation::advance(const Log& log, const StopQuery& stop_requested) {
   const auto t0 = std::chrono::steady_clock::now();
   const double remaining = end_time_ - time();
+  // fluid.flow_rate: the step's body work is taken with the step's own added force at both of its ends.
+  const int flow_axis = fluid_.params().flow_axis;
+  const double flow_momentum =
+      flow_axis >= 0 ? mean_velocity(flow_axis) * grid_.length(0) * grid_.length(1) * grid_.length(2) : 0.0;
+  const double flow_force = op_->fluid_state().flow_force;
   StepRecord r;
   std::ostringstream where;
   where.precision(10);
@@ -97,6 +103,7 @@ StepRecord Simulation::advance(const Log& log, const StopQuery& stop_requested) 
   r.step = step_;
   r.time = time();
   check_stability(r);
+  if (flow_axis >= 0) budget_.add_body_power((op_->fluid_state().flow_force - flow_force) * flow_momentum);
   budget_.advance(r.dt, fluid_energy());
   r.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return r;
@@ -136,6 +143,7 @@ io::Checkpoint Simulation::checkpoint() const {
                {std::size_t(f.p_prev.nz()), std::size_t(f.p_prev.ny()), std::size_t(f.p_prev.nx())});
   ck.put_double("fluid.dt_prev", f.dt_prev);
   ck.put_double("fluid.dt_prev2", f.dt_prev2);
+  if (f.flow_force != 0) ck.put_double("fluid.flow_force", f.flow_force);  // with fluid.flow_rate
   ck.put_int("fluid.step", f.step);
   ck.put_double("fluid.time", f.time);
   for (std::size_t m = 0; m < num_membranes(); ++m) {
@@ -181,6 +189,7 @@ void Simulation::restore(const io::Checkpoint& ck) {
   }
   f.step = count("fluid.step");
   f.time = time_value("fluid.time");
+  if (ck.has("fluid.flow_force")) f.flow_force = ck.get_double("fluid.flow_force");
   std::vector<std::vector<Vec3>> X(num_membranes());
   std::size_t unknowns = 0;
   for (std::size_t m = 0; m < num_membranes(); ++m) {

@@ -68,6 +68,8 @@ class Simulation final : public SimulationInterface {
   std::vector<MembraneEnergy> membrane_energies() const override;
   double min_wall_distance() const override { return op_->min_wall_distance(); }
   double mean_velocity(int d) const override;
+  const FluidParams& fluid_params() const override { return fluid_.params(); }
+  const FluidState& committed_fluid() const override { return op_->fluid_state(); }
   double wall_shear_stress(bool upper, double mu, double wall_velocity_x) const override;
   StepTimings timings() const override { return op_->timings(); }
   std::string thread_policy() const override { return op_->thread_governor().policy(); }

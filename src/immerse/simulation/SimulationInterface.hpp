@@ -14,6 +14,8 @@
 #include <vector>
 
 #include "immerse/core/Vec3.hpp"
+#include "immerse/fluid/FluidParams.hpp"
+#include "immerse/fluid/FluidState.hpp"
 #include "immerse/grid/Grid.hpp"
 #include "immerse/io/Checkpoint.hpp"
 #include "immerse/io/Config.hpp"
@@ -78,6 +80,12 @@ class SimulationInterface {
   /// The mean over the box of the fluid velocity component d (on a periodic axis d: the flow rate through a
   /// cross-section over its area). Collective.
   virtual double mean_velocity(int d) const = 0;
+  /// The body force of the step that reached the committed state (N/m^3): fluid.body_force, plus with fluid.flow_rate
+  /// the force that step added along the flow axis.
+  Vec3 step_body_force() const { return step_params(fluid_params(), committed_fluid()).body_force; }
+  /// The fluid's parameters and committed state (this process's slab of it when distributed).
+  virtual const FluidParams& fluid_params() const = 0;
+  virtual const FluidState& committed_fluid() const = 0;
   /// The mean shear stress μ (1 + χ) ∂u_x/∂z on the lower or upper z wall moving at wall_velocity_x along x
   /// (wall_shear_stress of FluidDiagnostics.hpp). Collective.
   virtual double wall_shear_stress(bool upper, double mu, double wall_velocity_x) const = 0;
