@@ -160,9 +160,6 @@ class NavierStokesSolver {
   /// unit body force along it (cached for the step size), so that its mean is FluidParams::flow_mean_velocity;
   /// out.flow_force = ΔG.
   void hold_flow_rate(double dt, FluidState& out);
-  Array3 flow_response_;          // w, for steps of flow_response_dt_
-  double flow_response_dt_ = 0;
-  double flow_response_mean_ = 0;  // its mean over the box
   /// Adds (Δt/ρ) μ ∇_h·(χ S(ũ)) to the right-hand side u* of (9) where χ is not zero.
   /// Component d of it, over the box of faces where it may not vanish (variable_stress_box).
   void add_variable_stress(const FaceField& utilde, const Array3& chi, double dt, int d, const IndexBox& box);
@@ -173,6 +170,9 @@ class NavierStokesSolver {
 
   MacStencilGrid geom0_;        // homogeneous walls: the part of ∇_h² that the remainder of a variable viscosity takes
   double mu_implicit_;   // μ_p (μ without a variable viscosity)
+  Array3 flow_response_;           // w of hold_flow_rate, for steps of flow_response_dt_
+  double flow_response_dt_ = 0;
+  double flow_response_mean_ = 0;  // its mean over the box
   PreparedStep own_;     // the one-pass step's preparation, with a variable viscosity
   std::array<std::unique_ptr<FftHelmholtzSolver>, 4> solvers_;
   FaceField ustar_;  // u*, then u^{n+1}

@@ -87,6 +87,10 @@ class SlabNavierStokesSolver {
   void exchange_ghosts(FluidState& s) const;
 
  private:
+  /// fluid.flow_rate (NavierStokesSolver.hpp, "Flow rate"): adds ΔG w to the flow axis's velocity of `out`, w the
+  /// step's response to a unit body force along it (cached for the step size), so that its mean over the box (summed
+  /// over the processes) is FluidParams::flow_mean_velocity; out.flow_force = ΔG.
+  void hold_flow_rate(double dt, FluidState& out);
   bool is_slab(const FaceField& f) const;
   void check(const FluidState& in, double dt, const FaceField& force) const;
   /// The wall velocities on the x and y walls of the velocity slabs (the z walls are the halo's).
@@ -100,11 +104,7 @@ class SlabNavierStokesSolver {
 
   Grid grid_;
   FluidParams params_;
-  /// fluid.flow_rate ("Flow rate" above): adds ΔG w to the flow axis's velocity of `out`, w the step's response to a
-  /// unit body force along it (cached for the step size), so that its mean (over all processes) is FluidParams::flow_mean_velocity;
-  /// out.flow_force = ΔG.
-  void hold_flow_rate(double dt, FluidState& out);
-  Array3 flow_response_;          // w, for steps of flow_response_dt_
+  Array3 flow_response_;           // w, for steps of flow_response_dt_
   double flow_response_dt_ = 0;
   double flow_response_mean_ = 0;  // its mean over the box
   SlabDecomposition slabs_;

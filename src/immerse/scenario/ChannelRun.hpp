@@ -6,8 +6,9 @@
 // U the mean velocity along y and U_0 that of the cell-free fluid (the discrete Poiseuille flow of PoiseuilleFlow.hpp)
 // under that body force: the duct's resistance with the cells over that of the plasma alone, the measure of the
 // Fåhræus–Lindqvist effect (Pries, Neuhaus & Gaehtgens 1992, Am. J. Physiol. 263:H1770).
-// Verified by the test RbcChannel.ThirtyTwoCellsInAPoiseuilleDuctWithTheirDiagnostics (1 at the start, then above 1;
-// the flow rate and the pressure drop from the mean velocity and the body force).
+// Verified by the tests RbcChannel.ThirtyTwoCellsInAPoiseuilleDuctWithTheirDiagnostics (1 at the start, then above 1;
+// the flow rate and the pressure drop from the mean velocity and the body force) and
+// RbcChannel.FlowRateIsHeldWhileThePressureDropRises (the pressure drop of the force fluid.flow_rate adds).
 #include <optional>
 
 #include "immerse/scenario/CellScenarioRun.hpp"
