@@ -4,6 +4,7 @@ set -euo pipefail
 pkgs=(cmake g++ make pkg-config lld  # lld: the presets link with it (several times faster than ld)
       libfftw3-dev libfftw3-mpi-dev libhdf5-dev libtomlplusplus-dev libcli11-dev
       petsc-dev openmpi-bin libopenmpi-dev  # MPI: the distributed solver and its tests (mpiexec)
+      liblapack-dev  # the dense LU of the walls' capacitance matrix (fluid/GhostCellWalls)
       libgtest-dev libgmock-dev libbenchmark-dev
       python3 python3-matplotlib python3-numpy python3-h5py python3-meshio python3-dev pybind11-dev
       mkdocs mkdocs-material  # scripts/build-docs.sh (the documentation site, test docs.site)

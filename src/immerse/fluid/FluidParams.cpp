@@ -17,6 +17,8 @@ void FluidParams::validate(const Grid& grid) const {
   if (flow_axis >= 0)
     require(grid.periodic(flow_axis), std::string("fluid.flow_rate.") + axis_name(flow_axis),
             std::string("zero: a flow rate is held along a periodic axis, and ") + axis_name(flow_axis) + " has walls");
+  if (walls)
+    require(flow_axis < 0, "fluid.flow_rate", "zero with [[wall]] shapes (drive the flow by fluid.body_force)");
   for (int a = 0; a < 3; ++a) {
     if (grid.periodic(a)) continue;
     for (int d = 0; d < 3; ++d) {

@@ -6,11 +6,14 @@
 // with wall_upper[a] (constant in time); entries for periodic axes are ignored.
 // Also the one numerical choice of the step (NavierStokesSolver.hpp): the pressure that (9) takes.
 #include <array>
+#include <memory>
 
 #include "immerse/core/Vec3.hpp"
 #include "immerse/grid/Grid.hpp"
 
 namespace immerse {
+
+class WallGeometry;
 
 /// The pressure in the momentum step (9): p^{n−1/2} as printed (Lagged), or extrapolated to t^{n+1/2} from p^{n−1/2}
 /// and p^{n−3/2} (Extrapolated; second order in time also where the fluid is a Stokes flow at the step's scale).
@@ -32,6 +35,8 @@ struct FluidParams {
   /// off), by the uniform body force it adds along that axis (NavierStokesSolver.hpp, "Flow rate").
   int flow_axis = -1;
   double flow_mean_velocity = 0;
+  /// Rigid walls of any shape inside a periodic box ([[wall]]; GhostCellWalls): null for none.
+  std::shared_ptr<const WallGeometry> walls;
 
   /// Throws a one-line InputError unless rho, mu > 0 and finite, the body force and wall velocities are finite,
   /// and on every wall axis the normal wall velocity is the same at both walls (zero net flux through the

@@ -47,6 +47,7 @@ NavierStokesSolver::NavierStokesSolver(const Grid& grid, const FluidParams& para
   params_.validate(grid_);
   for (int l = 0; l < 4; ++l)
     solvers_[l] = std::make_unique<FftHelmholtzSolver>(grid_, static_cast<Layout>(l), planning, l < 3 ? &ustar_[l] : &phi_);
+  if (params_.walls) walls_ = std::make_unique<GhostCellWalls>(grid_, *params_.walls);
 }
 
 FluidState NavierStokesSolver::initial_state() const {
@@ -120,7 +121,12 @@ void NavierStokesSolver::advance(const FluidState& in, double dt, const Array3& 
 
   for (int d = 0; d < 3; ++d) {
     rhs(d);
-    solvers_[d]->solve(ustar_[d], 1.0, -c);
+    if (walls_) {
+      walls_->add_explicit_correction(d, in.u[d], 0.5 * params_.mu * dt / rho, ustar_[d]);
+      walls_->solve(d, ustar_[d], 1.0, -c, *solvers_[d]);
+    }
+    else
+      solvers_[d]->solve(ustar_[d], 1.0, -c);
   }
   apply_wall_values(ustar_);
 

@@ -42,6 +42,9 @@
 // Verified by the tests RbcChannel.FlowRateIsHeldWhileThePressureDropRises, RestartFlowRate.* and
 // ParallelRun.RedCellChannelAtAFlowRateEqualsTheOneProcessRun.
 //
+// Walls of any shape (FluidParams::walls, a periodic box): the Helmholtz problems of (9) take the no-slip condition
+// on them by GhostCellWalls (two fast solves each); the projection stays periodic.
+//
 // Variable viscosity (FluidParams::variable_viscosity; docs/viscosity-contrast.md). With μ(x) = μ (1 + χ(x)) the
 // viscous term of (9) is ½[∇_h·(μ(∇_h u* + ∇_h u*ᵀ)) + ∇_h·(μ(∇_h u^n + ∇_h u^nᵀ))]. The fast solvers invert only
 // the constant part: with μ_p = implicit_ratio · μ ≥ max μ(x) and L_μ the stress operator, (9) takes
@@ -67,6 +70,7 @@
 #include "immerse/fluid/FftHelmholtzSolver.hpp"
 #include "immerse/fluid/FluidParams.hpp"
 #include "immerse/fluid/FluidState.hpp"
+#include "immerse/fluid/GhostCellWalls.hpp"
 #include "immerse/fluid/MacStencilGrid.hpp"
 
 namespace immerse {
@@ -139,6 +143,9 @@ class NavierStokesSolver {
   /// Writes the normal wall velocity into the wall faces of u (the boundary condition (3)).
   void apply_wall_values(FaceField& u) const;
 
+  /// The no-slip condition of the [[wall]] shapes, if any (null: none).
+  const GhostCellWalls* walls() const { return walls_.get(); }
+
   /// The fast solver of a layout (three velocity components and the pressure).
   FftHelmholtzSolver& fast_solver(Layout layout) { return *solvers_[static_cast<int>(layout)]; }
 
@@ -175,6 +182,7 @@ class NavierStokesSolver {
   double flow_response_mean_ = 0;  // its mean over the box
   PreparedStep own_;     // the one-pass step's preparation, with a variable viscosity
   std::array<std::unique_ptr<FftHelmholtzSolver>, 4> solvers_;
+  std::unique_ptr<GhostCellWalls> walls_;  // the no-slip condition of [[wall]] in (9), if any
   FaceField ustar_;  // u*, then u^{n+1}
   Array3 div_;       // D u*
   Array3 phi_;       // pressure increment φ^{n+1}

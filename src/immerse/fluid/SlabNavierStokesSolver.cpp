@@ -42,6 +42,7 @@ SlabNavierStokesSolver::SlabNavierStokesSolver(const Grid& grid, const FluidPara
       halo0_(slabs_, Vec3{}, Vec3{}),
       mu_implicit_(params.variable_viscosity ? params.implicit_ratio * params.mu : params.mu) {
   params_.validate(grid_);
+  require(!params_.walls, "[[wall]]", "absent in a run on several processes (walls of any shape run on one process)");
   for (MacStencilGrid* g : {&local_, &local0_}) {
     g->n[2] = slabs_.local_shape(Layout::Pressure)[2];
     g->periodic[2] = true;

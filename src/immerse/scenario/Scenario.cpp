@@ -288,6 +288,9 @@ io::Config check_suspension_shear(const io::Config& config) {
 io::Config derive(const io::Config& config) {
   const std::string kind = config.get<std::string>("scenario.kind");
   if (kind == "suspension_shear") return derive_contact(derive_centres(check_suspension_shear(config)));
+  if (kind == "tube_flow")
+    require(config.count("wall") > 0 && config.entry("wall", 0).get<std::string>("shape") == "tube", "wall[0].shape",
+            "\"tube\" for scenario.kind = \"tube_flow\" (the tube whose flow rate it reports)");
   if (kind == "rbc_stretch" || kind == "rbc_channel") return derive_contact(derive_centres(derive_cells(config, kind)));
   if (is_shear(kind)) return derive_contact(derive_centres(derive_shear(config, kind)));
   return derive_contact(derive_centres(config));

@@ -3,6 +3,7 @@
 #include "immerse/scenario/ChannelRun.hpp"
 #include "immerse/scenario/StretchSweepRun.hpp"
 #include "immerse/scenario/SuspensionShearRun.hpp"
+#include "immerse/scenario/TubeFlowRun.hpp"
 
 namespace immerse {
 
@@ -11,6 +12,7 @@ std::unique_ptr<ScenarioRun> make_scenario_run(const io::Config& config) {
   if (kind == "rbc_stretch") return std::make_unique<StretchSweepRun>();
   if (kind == "rbc_channel") return std::make_unique<ChannelRun>();
   if (kind == "suspension_shear") return std::make_unique<SuspensionShearRun>(config);
+  if (kind == "tube_flow") return std::make_unique<TubeFlowRun>();
   return std::make_unique<ScenarioRun>();
 }
 

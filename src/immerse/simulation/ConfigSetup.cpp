@@ -6,6 +6,7 @@
 
 #include "immerse/core/Error.hpp"
 #include "immerse/fluid/PoiseuilleFlow.hpp"
+#include "immerse/walls/WallGeometry.hpp"
 
 namespace immerse {
 
@@ -72,6 +73,20 @@ FluidParams run_fluid_params(const io::Config& c) {
     for (int d = 0; d < 3; ++d)
       if (d != p.flow_axis) section *= c.get<double>(std::string("domain.L") + axis_name(d));
     p.flow_mean_velocity = Q[p.flow_axis] / section;
+  }
+  if (c.count("wall") > 0) {
+    std::vector<WallShape> shapes;
+    for (std::size_t i = 0; i < c.count("wall"); ++i) {
+      const io::Config& w = c.entry("wall", i);
+      WallShape s;
+      s.kind = w.get<std::string>("shape") == "sphere" ? WallShape::Kind::Sphere : WallShape::Kind::Tube;
+      s.radius = w.get<double>("radius");
+      s.center = w.get<Vec3>("center");
+      s.axis = w.get<Vec3>("axis");
+      s.name = "wall[" + std::to_string(i) + "]";
+      shapes.push_back(s);
+    }
+    p.walls = std::make_shared<const WallGeometry>(std::move(shapes), run_grid(c));
   }
   return p;
 }

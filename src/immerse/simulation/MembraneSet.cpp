@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <limits>
 #include <sstream>
 
 #include "immerse/contact/CellPacking.hpp"
@@ -18,6 +19,8 @@
 #include "immerse/membrane/Shape.hpp"
 #include "immerse/membrane/Skalak.hpp"
 #include "immerse/membrane/Yeoh.hpp"
+#include "immerse/simulation/ConfigSetup.hpp"
+#include "immerse/walls/WallGeometry.hpp"
 
 namespace immerse {
 
@@ -294,6 +297,20 @@ void Builder::check_geometry() const {
       s << membrane_name(m) << " comes within " << d << " m of a wall: must keep at least one cell (" << h
         << " m) clear for the delta function" << unit_hint(config_, m);
       throw InputError(s.str());
+    }
+  }
+  if (config_.count("wall") > 0) {
+    const std::shared_ptr<const WallGeometry> walls = run_fluid_params(config_).walls;
+    for (std::size_t m = 0; m < initial_.size(); ++m) {
+      double nearest = std::numeric_limits<double>::infinity();
+      for (const Vec3& x : initial_[m]) nearest = std::min(nearest, walls->distance(x));
+      if (nearest < h) {
+        std::ostringstream s;
+        s << membrane_name(m) << (nearest <= 0 ? " starts inside a [[wall]] (a node " : " comes within ")
+          << std::abs(nearest) << (nearest <= 0 ? " m deep" : " m of a [[wall]]")
+          << "): must keep at least one cell (" << h << " m) clear of the walls" << unit_hint(config_, m);
+        throw InputError(s.str());
+      }
     }
   }
   if (const auto gap = closest_foreign_nodes(grid_, initial_, h)) {

@@ -75,13 +75,26 @@ ConfigSchema membrane_schema() {
   return m;
 }
 
+ConfigSchema wall_schema() {
+  ConfigSchema w;
+  w.add_string("shape", "tube", {"tube", "sphere"},
+               "tube: the fluid inside a circular cylinder (radius, center, axis), everything outside it wall; sphere: "
+               "a solid ball (radius, center) (src/immerse/walls/WallGeometry.hpp)");
+  w.add_double("radius", 1e-6, Range::positive(), "radius of the tube or sphere (m)");
+  w.add_vec3("center", {0, 0, 0}, Range::any(), "a point on the tube's axis, or the sphere's centre (m); in the box");
+  w.add_vec3("axis", {0, 0, 1}, Range::any(),
+             "tube: direction of its axis, along (mx Lx, my Ly, mz Lz) with whole numbers m, so that the tube closes on "
+             "itself across the periodic box ([0, 0, 1]: along z; [1, 0, 2] in a box with Lz = Lx: at 26.6 degrees)");
+  return w;
+}
+
 }  // namespace
 
 ConfigSchema run_schema() {
   ConfigSchema s;
   s.add_string("scenario.kind", "custom",
                {"custom", "none", "oscillating_membrane", "capsule_shear", "oblate_shear", "bending_shear",
-                "rbc_stretch", "rbc_channel", "suspension_shear"},
+                "rbc_stretch", "rbc_channel", "suspension_shear", "tube_flow"},
                "custom: your own experiment, every value as given (\"none\" is its former name); otherwise an experiment "
                "of the paper whose nondimensional groups below set the dimensional values the file leaves unset "
                "(see scenarios/README.md)");
@@ -197,6 +210,9 @@ ConfigSchema run_schema() {
   s.add_double("packing.clearance", 0.0, Range::non_negative(),
                "least distance between nodes of two copies and from a node to a wall (m); 0: 1.1 grid spacings");
   s.add_table_array("membrane", membrane_schema(), 0, "the membranes (capsules, cells), one [[membrane]] table each");
+  s.add_table_array("wall", wall_schema(), 0,
+                    "rigid no-slip walls of any shape inside a box periodic along every axis, one [[wall]] table each; "
+                    "the wall is the union of their solids (fluid/GhostCellWalls.hpp)");
   return s;
 }
 

@@ -51,6 +51,8 @@ Simulation::Simulation(const io::Config& config, const std::function<bool()>& st
 }
 
 FluidEnergy Simulation::fluid_energy() const {
+  if (const GhostCellWalls* walls = fluid_.walls())
+    return walls->energy(step_params(fluid_.params(), op_->fluid_state()), op_->fluid_state().u);
   const Array3& chi = op_->viscosity_indicator();
   return immerse::fluid_energy(grid_, step_params(fluid_.params(), op_->fluid_state()), op_->fluid_state().u,
                                chi.size() > 0 ? &chi : nullptr);

@@ -1,0 +1,260 @@
+#include "immerse/fluid/GhostCellWalls.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <map>
+#include <string>
+
+#include "immerse/core/Error.hpp"
+#include "immerse/fluid/FftHelmholtzSolver.hpp"
+
+extern "C" {
+// LAPACK (Fortran calling convention; the hidden length of the character argument last).
+void dgetrf_(const int* m, const int* n, double* a, const int* lda, int* ipiv, int* info);
+void dgetrs_(const char* trans, const int* n, const int* nrhs, const double* a, const int* lda, const int* ipiv,
+             double* b, const int* ldb, int* info, std::size_t trans_length);
+}
+
+namespace immerse {
+
+namespace {
+
+struct LatticeIndex {
+  std::array<int, 3> n;
+  std::size_t flat(int i, int j, int k) const {
+    const auto wrap = [](int q, int m) { return ((q % m) + m) % m; };
+    return wrap(i, n[0]) +
+           static_cast<std::size_t>(n[0]) * (wrap(j, n[1]) + static_cast<std::size_t>(n[1]) * wrap(k, n[2]));
+  }
+  std::array<int, 3> ijk(std::size_t f) const {
+    const int i = static_cast<int>(f % n[0]);
+    const std::size_t r = f / n[0];
+    return {i, static_cast<int>(r % n[1]), static_cast<int>(r / n[1])};
+  }
+};
+
+}  // namespace
+
+GhostCellWalls::GhostCellWalls(const Grid& grid, const WallGeometry& walls)
+    : grid_(grid),
+      alpha_(std::numeric_limits<double>::quiet_NaN()),
+      beta_(alpha_),
+      scratch_(grid.n(0), grid.n(1), grid.n(2)) {
+  for (int a = 0; a < 3; ++a)
+    if (!grid.periodic(a))
+      throw InputError(std::string("boundary.") + axis_name(a) +
+                       " = \"wall\": [[wall]] needs a box periodic along every "
+                       "axis (the [[wall]] shapes are the walls)");
+  const LatticeIndex L{grid.n()};
+  const double h = grid.h();
+  const std::size_t count = static_cast<std::size_t>(grid.n(0)) * grid.n(1) * grid.n(2);
+  std::vector<double> phi(count);
+  for (int d = 0; d < 3; ++d) {
+    Component& c = comp_[d];
+    c.fluid.assign(count, 0);
+    for (int k = 0; k < grid.n(2); ++k)
+      for (int j = 0; j < grid.n(1); ++j)
+        for (int i = 0; i < grid.n(0); ++i) {
+          const std::size_t f = L.flat(i, j, k);
+          phi[f] = walls.distance(grid.face_position(d, i, j, k));
+          c.fluid[f] = phi[f] > 0;
+        }
+    c.row_start.push_back(0);
+    for (std::size_t f = 0; f < count; ++f) {
+      if (!c.fluid[f]) {
+        c.solid.push_back(f);
+        continue;
+      }
+      const auto [i, j, k] = L.ijk(f);
+      const std::array<int, 3> q{i, j, k};
+      const Vec3 x = grid.face_position(d, i, j, k);
+      // Shortley–Weller: per axis, the arms to the neighbours or to the wall crossing in between (value 0).
+      std::map<std::size_t, double> row;
+      double diag = 0;
+      bool cut = false;
+      for (int a = 0; a < 3; ++a) {
+        std::array<double, 2> arm{h, h};
+        std::array<std::size_t, 2> nb{};
+        for (int side = 0; side < 2; ++side) {
+          std::array<int, 3> qn = q;
+          qn[a] += side ? 1 : -1;
+          nb[side] = L.flat(qn[0], qn[1], qn[2]);
+          if (c.fluid[nb[side]]) continue;
+          cut = true;
+          Vec3 e{};
+          e[a] = side ? h : -h;
+          double lo = 0, hi = 1;  // φ(x + lo e) > 0 ≥ φ(x + hi e)
+          for (int it = 0; it < 50; ++it) {
+            const double mid = 0.5 * (lo + hi);
+            (walls.distance(x + mid * e) > 0 ? lo : hi) = mid;
+          }
+          arm[side] = std::max(0.5 * (lo + hi), 1e-6) * h;
+        }
+        const double hl = arm[0], hr = arm[1];
+        diag -= 2.0 / (hl * hr);
+        if (c.fluid[nb[0]]) row[nb[0]] += 2.0 / (hl * (hl + hr));
+        if (c.fluid[nb[1]]) row[nb[1]] += 2.0 / (hr * (hl + hr));
+      }
+      if (!cut) continue;
+      row[f] += diag;  // the Laplacian's row; factorization() and solve() take α + β times it
+      c.cut.push_back(f);
+      for (const auto& [col, v] : row) {
+        c.col.push_back(col);
+        c.val.push_back(v);
+        c.diag.push_back(col == f);
+      }
+      c.row_start.push_back(c.col.size());
+    }
+  }
+}
+
+const GhostCellWalls::Factorization& GhostCellWalls::factorization(double alpha, double beta, Array3& x,
+                                                                    FftHelmholtzSolver& fast) {
+  ++uses_;
+  alpha_ = alpha;
+  beta_ = beta;
+  for (Factorization& f : factors_)
+    if (f.alpha == alpha && f.beta == beta) {
+      f.used = uses_;
+      return f;
+    }
+  // Keep up to 8 step sizes (the trials of an adaptive or halved step, a cycle of steps), within 1 GB.
+  std::size_t bytes = 0;
+  for (const Component& c : comp_) bytes += c.cut.size() * c.cut.size() * sizeof(double);
+  const std::size_t keep = std::clamp<std::size_t>(bytes > 0 ? (std::size_t{1} << 30) / bytes : 8, 1, 8);
+  if (factors_.size() >= keep) {
+    const auto oldest = std::min_element(factors_.begin(), factors_.end(),
+                                         [](const Factorization& a, const Factorization& b) { return a.used < b.used; });
+    factors_.erase(oldest);
+  }
+  Factorization& fac = factors_.emplace_back();
+  fac.alpha = alpha;
+  fac.beta = beta;
+  fac.used = uses_;
+  scratch_.values() = x.values();
+  std::fill(x.values().begin(), x.values().end(), 0.0);
+  x(0, 0, 0) = 1.0;
+  fast.solve(x, alpha, beta);
+  const std::vector<double> green = x.values();
+  x.values() = scratch_.values();
+  const LatticeIndex L{grid_.n()};
+  for (int d = 0; d < 3; ++d) {
+    const Component& c = comp_[d];
+    const int n = static_cast<int>(c.cut.size());
+    std::vector<double>& lu = fac.lu[d];
+    lu.assign(static_cast<std::size_t>(n) * n, 0.0);
+    fac.pivot[d].assign(n, 0);
+    if (n == 0) continue;
+    std::vector<std::array<int, 3>> at(c.col.size());
+    std::vector<double> a(c.col.size());
+    for (std::size_t e = 0; e < c.col.size(); ++e) {
+      at[e] = L.ijk(c.col[e]);
+      a[e] = beta * c.val[e] + (c.diag[e] ? alpha : 0.0);
+    }
+#pragma omp parallel for schedule(static)
+    for (int j = 0; j < n; ++j) {
+      const std::array<int, 3> qj = L.ijk(c.cut[j]);
+      double* const column = lu.data() + static_cast<std::size_t>(j) * n;
+      for (int i = 0; i < n; ++i) {
+        double sum = 0;
+        for (std::size_t e = c.row_start[i]; e < c.row_start[i + 1]; ++e)
+          sum += a[e] * green[L.flat(at[e][0] - qj[0], at[e][1] - qj[1], at[e][2] - qj[2])];
+        column[i] = sum;
+      }
+    }
+    int info = 0;
+    dgetrf_(&n, &n, lu.data(), &n, fac.pivot[d].data(), &info);
+    if (info != 0)
+      throw SimulationError("GhostCellWalls: the capacitance matrix of velocity component " + std::to_string(d) +
+                            " is singular (LAPACK dgetrf info " + std::to_string(info) + ")");
+  }
+  return fac;
+}
+
+double GhostCellWalls::row_times(const Component& c, std::size_t i, const double* u) const {
+  double sum = 0;
+  for (std::size_t e = c.row_start[i]; e < c.row_start[i + 1]; ++e)
+    sum += (beta_ * c.val[e] + (c.diag[e] ? alpha_ : 0.0)) * u[c.col[e]];
+  return sum;
+}
+
+void GhostCellWalls::solve(int d, Array3& x, double alpha, double beta, FftHelmholtzSolver& fast) {
+  const Factorization& fac = factorization(alpha, beta, x, fast);
+  const Component& c = comp_[d];
+  double* const u = x.data();
+  const int n = static_cast<int>(c.cut.size());
+  rhs_.resize(n);
+  for (int i = 0; i < n; ++i) rhs_[i] = u[c.cut[i]];  // b at the cut rows
+  for (const std::size_t f : c.solid) u[f] = 0.0;
+  fast.solve(x, alpha, beta);  // v = H⁻¹ b
+  if (n == 0) return;
+  for (int i = 0; i < n; ++i) rhs_[i] = row_times(c, i, u) - rhs_[i];  // Wᵀ v = a v − b
+  const int one = 1;
+  int info = 0;
+  dgetrs_("N", &n, &one, fac.lu[d].data(), &n, fac.pivot[d].data(), rhs_.data(), &n, &info, 1);
+  scratch_.values() = x.values();
+  std::fill(x.values().begin(), x.values().end(), 0.0);
+  for (int i = 0; i < n; ++i) u[c.cut[i]] = rhs_[i];
+  fast.solve(x, alpha, beta);  // H⁻¹ E C⁻¹ Wᵀ v
+  const std::vector<double>& v = scratch_.values();
+  std::vector<double>& out = x.values();
+  for (std::size_t f = 0; f < out.size(); ++f) out[f] = v[f] - out[f];
+}
+
+void GhostCellWalls::add_explicit_correction(int d, const Array3& un, double c, Array3& rhs) const {
+  const Component& comp = comp_[d];
+  const LatticeIndex L{grid_.n()};
+  const double inv_h2 = 1.0 / (grid_.h() * grid_.h());
+  const double* const u = un.data();
+  for (std::size_t i = 0; i < comp.cut.size(); ++i) {
+    double cut = 0;
+    for (std::size_t e = comp.row_start[i]; e < comp.row_start[i + 1]; ++e) cut += comp.val[e] * u[comp.col[e]];
+    const auto [x, y, z] = L.ijk(comp.cut[i]);
+    const double periodic =
+        (u[L.flat(x - 1, y, z)] + u[L.flat(x + 1, y, z)] + u[L.flat(x, y - 1, z)] + u[L.flat(x, y + 1, z)] +
+         u[L.flat(x, y, z - 1)] + u[L.flat(x, y, z + 1)] - 6.0 * u[comp.cut[i]]) *
+        inv_h2;
+    rhs.data()[comp.cut[i]] += c * (cut - periodic);
+  }
+}
+
+FluidEnergy GhostCellWalls::energy(const FluidParams& params, const FaceField& u) const {
+  const LatticeIndex L{grid_.n()};
+  const double h3 = grid_.h() * grid_.h() * grid_.h(), inv_h2 = 1.0 / (grid_.h() * grid_.h());
+  FluidEnergy e;
+  for (int d = 0; d < 3; ++d) {
+    const Component& c = comp_[d];
+    const double* const v = u[d].data();
+    std::vector<double> lap(u[d].size(), 0.0);  // L_c u at the fluid points
+    for (std::size_t f = 0; f < lap.size(); ++f) {
+      if (!c.fluid[f]) continue;
+      const auto [x, y, z] = L.ijk(f);
+      lap[f] = (v[L.flat(x - 1, y, z)] + v[L.flat(x + 1, y, z)] + v[L.flat(x, y - 1, z)] + v[L.flat(x, y + 1, z)] +
+                v[L.flat(x, y, z - 1)] + v[L.flat(x, y, z + 1)] - 6.0 * v[f]) *
+               inv_h2;
+    }
+    for (std::size_t i = 0; i < c.cut.size(); ++i) {
+      double s = 0;
+      for (std::size_t k = c.row_start[i]; k < c.row_start[i + 1]; ++k) s += c.val[k] * v[c.col[k]];
+      lap[c.cut[i]] = s;
+    }
+    for (std::size_t f = 0; f < lap.size(); ++f) {
+      if (!c.fluid[f]) continue;
+      e.kinetic += 0.5 * params.rho * v[f] * v[f] * h3;
+      e.dissipation -= params.mu * v[f] * lap[f] * h3;
+      e.body += params.body_force[d] * v[f] * h3;
+    }
+  }
+  return e;
+}
+
+double GhostCellWalls::cut_residual(int d, const Array3& x, const Array3& b) const {
+  const Component& c = comp_[d];
+  double worst = 0;
+  for (std::size_t i = 0; i < c.cut.size(); ++i)
+    worst = std::max(worst, std::abs(row_times(c, i, x.data()) - b.data()[c.cut[i]]));
+  return worst;
+}
+
+}  // namespace immerse

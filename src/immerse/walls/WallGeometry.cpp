@@ -1,0 +1,150 @@
+#include "immerse/walls/WallGeometry.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+
+#include "immerse/core/Error.hpp"
+
+namespace immerse {
+
+namespace {
+
+std::string vec_text(const Vec3& v) {
+  char buf[96];
+  std::snprintf(buf, sizeof buf, "[%g, %g, %g]", v.x, v.y, v.z);
+  return buf;
+}
+
+std::string num_text(double x) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%g", x);
+  return buf;
+}
+
+// The periodic lattice vectors Σ m_a L_a e_a with |m_a| ≤ reach over the periodic axes (m = 0 included).
+template <class F>
+void for_each_image(const std::array<bool, 3>& periodic, const Vec3& length, int reach, F&& f) {
+  const int rx = periodic[0] ? reach : 0, ry = periodic[1] ? reach : 0, rz = periodic[2] ? reach : 0;
+  for (int mz = -rz; mz <= rz; ++mz)
+    for (int my = -ry; my <= ry; ++my)
+      for (int mx = -rx; mx <= rx; ++mx) f(Vec3{mx * length.x, my * length.y, mz * length.z});
+}
+
+}  // namespace
+
+WallGeometry::WallGeometry(std::vector<WallShape> shapes, const Grid& grid)
+    : shapes_(std::move(shapes)), origin_(grid.origin()) {
+  for (int a = 0; a < 3; ++a) {
+    length_[a] = grid.length(a);
+    periodic_[a] = grid.periodic(a);
+  }
+  for (int a = 0; a < 3; ++a)
+    if (!periodic_[a])
+      throw InputError(std::string("boundary.") + axis_name(a) +
+                       " = \"wall\": [[wall]] needs a box periodic along every "
+                       "axis (the [[wall]] shapes are the walls)");
+  for (WallShape& s : shapes_) {
+    if (!(s.radius > 0) || !std::isfinite(s.radius))
+      throw InputError(s.name + ".radius = " + num_text(s.radius) + ": must be positive");
+    if (!isfinite(s.center)) throw InputError(s.name + ".center = " + vec_text(s.center) + ": must be finite");
+    if (s.kind == WallShape::Kind::Sphere) {
+      for (int a = 0; a < 3; ++a) {
+        if (s.center[a] < origin_[a] || s.center[a] > origin_[a] + length_[a])
+          throw InputError(s.name + ".center = " + vec_text(s.center) + ": must lie in the box");
+        if (periodic_[a] && 2 * s.radius >= length_[a])
+          throw InputError(s.name + ".radius = " + num_text(s.radius) +
+                           ": the sphere meets its periodic image (the "
+                           "diameter must be below the box length " +
+                           num_text(length_[a]) + " along " + axis_name(a) + ")");
+      }
+      continue;
+    }
+    if (!isfinite(s.axis) || norm(s.axis) == 0)
+      throw InputError(s.name + ".axis = " + vec_text(s.axis) + ": must be a non-zero direction");
+    const Vec3 given = s.axis;
+    s.axis = normalized(s.axis);
+    for (int a = 0; a < 3; ++a)
+      if (s.center[a] < origin_[a] || s.center[a] > origin_[a] + length_[a])
+        throw InputError(s.name + ".center = " + vec_text(s.center) + ": must lie in the box");
+    // The axis returns onto itself after the lattice vector m_a L_a e_a (whole m_a, zero on a wall axis).
+    bool closes = false;
+    int lead = 0;
+    for (int a = 1; a < 3; ++a)
+      if (std::abs(s.axis[a]) / length_[a] > std::abs(s.axis[lead]) / length_[lead]) lead = a;
+    for (int m = 1; m <= 16 && !closes; ++m) {
+      const Vec3 v = s.axis * (m * length_[lead] / std::abs(s.axis[lead]));
+      closes = true;
+      for (int a = 0; a < 3; ++a) {
+        const double ma = v[a] / length_[a];
+        if (std::abs(ma - std::round(ma)) > 1e-6 * m || (!periodic_[a] && std::round(ma) != 0)) closes = false;
+      }
+      if (closes) s.period = norm(v);
+    }
+    if (!closes)
+      throw InputError(s.name + ".axis = " + vec_text(given) +
+                       ": a tube must close on itself across the box (its axis "
+                       "along (mx Lx, my Ly, mz Lz) with whole "
+                       "numbers m up to 16)");
+    double clearance = std::numeric_limits<double>::infinity();
+    for_each_image(periodic_, length_, 2, [&](const Vec3& v) {
+      const Vec3 perp = v - dot(v, s.axis) * s.axis;
+      if (norm(perp) > 1e-9 * norm(length_)) clearance = std::min(clearance, norm(perp));
+    });
+    if (2 * s.radius >= clearance)
+      throw InputError(s.name + ".radius = " + num_text(s.radius) +
+                       ": the tube meets its periodic image (the diameter must be below " + num_text(clearance) +
+                       ", the distance between the tube's axis and its nearest image)");
+  }
+}
+
+double WallGeometry::shape_distance(const WallShape& s, const Vec3& x, Vec3& grad) const {
+  Vec3 r = x - s.center;
+  for (int a = 0; a < 3; ++a)
+    if (periodic_[a]) r[a] -= length_[a] * std::floor(r[a] / length_[a] + 0.5);
+  const bool tube = s.kind == WallShape::Kind::Tube;
+  double best = tube ? -std::numeric_limits<double>::infinity() : std::numeric_limits<double>::infinity();
+  for_each_image(periodic_, length_, 1, [&](const Vec3& v) {
+    const Vec3 q = r + v;
+    if (tube) {
+      const Vec3 perp = q - dot(q, s.axis) * s.axis;
+      const double d = norm(perp),
+                   phi = s.radius - d;  // fluid inside any image of the tube
+      if (phi > best) {
+        best = phi;
+        grad = d > 0 ? perp * (-1.0 / d) : Vec3{};
+      }
+    } else {
+      const double d = norm(q),
+                   phi = d - s.radius;  // solid inside every image of the ball
+      if (phi < best) {
+        best = phi;
+        grad = d > 0 ? q / d : Vec3{};
+      }
+    }
+  });
+  return best;
+}
+
+double WallGeometry::distance(const Vec3& x) const {
+  double phi = std::numeric_limits<double>::infinity();
+  Vec3 g;
+  for (const WallShape& s : shapes_) phi = std::min(phi, shape_distance(s, x, g));
+  return phi;
+}
+
+Vec3 WallGeometry::normal(const Vec3& x) const {
+  double phi = std::numeric_limits<double>::infinity();
+  Vec3 n{}, g;
+  for (const WallShape& s : shapes_) {
+    const double d = shape_distance(s, x, g);
+    if (d < phi) {
+      phi = d;
+      n = g;
+    }
+  }
+  return n;
+}
+
+}  // namespace immerse

@@ -1,0 +1,54 @@
+#pragma once
+// Rigid walls of any shape inside a periodic box ([[wall]] in the configuration; docs/walls.md), represented by the
+// signed distance
+//   φ(x) > 0 in the fluid,   φ(x) < 0 inside a wall,   |∇φ| = 1,
+// exact for each analytic shape and taken to the nearest periodic image of it:
+//   tube    the fluid inside a circular cylinder of radius R about the line     φ = R − |(x − c) − ((x − c)·t) t|
+//           through c along the unit vector t (everything outside is wall)
+//   sphere  a solid ball of radius R at c                                        φ = |x − c| − R
+// The wall is the union of the shapes' solids, so φ = min over the shapes (exact wherever one shape is nearest, and its
+// sign always right). A tube must close on itself across the box: t along a whole-number combination of the periodic
+// box's edge vectors, with the tube clear of its own periodic images. Verified by the tests WallGeometry.* (distances,
+// normals, images, bad input) and, through the no-slip condition, GhostCellWalls.* and TubeFlow.*.
+#include <array>
+#include <string>
+#include <vector>
+
+#include "immerse/core/Vec3.hpp"
+#include "immerse/grid/Grid.hpp"
+
+namespace immerse {
+
+struct WallShape {
+  enum class Kind { Tube, Sphere };
+  Kind kind = Kind::Tube;
+  Vec3 center{};
+  Vec3 axis{0, 0, 1};  ///< tube: its direction (normalized by WallGeometry)
+  double radius = 0;
+  double period = 0;   ///< tube: the length of its axis in one period of the box (set by WallGeometry)
+  std::string name;    ///< "wall[i]", for messages
+};
+
+class WallGeometry {
+ public:
+  /// Validates the shapes against the box (InputError naming the item): radius > 0, a tube's axis a lattice direction
+  /// of the box and the tube clear of its images, a sphere's centre in the box and the ball inside one period.
+  WallGeometry(std::vector<WallShape> shapes, const Grid& grid);
+
+  /// φ(x): the signed distance to the nearest wall, positive in the fluid.
+  double distance(const Vec3& x) const;
+  /// ∇φ at x: the unit normal of the nearest wall, pointing into the fluid.
+  Vec3 normal(const Vec3& x) const;
+
+  const std::vector<WallShape>& shapes() const { return shapes_; }
+
+ private:
+  /// φ of one shape at x (nearest periodic image) and its gradient.
+  double shape_distance(const WallShape& s, const Vec3& x, Vec3& grad) const;
+
+  std::vector<WallShape> shapes_;
+  Vec3 origin_, length_;
+  std::array<bool, 3> periodic_{};
+};
+
+}  // namespace immerse

@@ -1,0 +1,113 @@
+// The tube_flow scenario: walls of any shape through `immerse run` — Poiseuille's flow rate in its columns, the energy
+// budget at the steady state, a bitwise restart, and bad input about walls (exit 2, one line, nothing written).
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <fstream>
+
+#include "test_run_support.hpp"
+
+using namespace immerse;
+using namespace immerse::testing;
+
+namespace {
+
+std::size_t column(const std::vector<std::string>& head, const std::string& name) {
+  const auto it = std::find(head.begin(), head.end(), name);
+  EXPECT_NE(it, head.end()) << name;
+  return static_cast<std::size_t>(it - head.begin());
+}
+
+TEST(TubeFlow, ScenarioReachesPoiseuilleFlowRate) {
+  ScratchDir dir("tube_flow");
+  const auto r =
+      run_immerse(run_args(scenario_file("tube_flow.toml"), dir / "out", {"output.fields_every=0"}), dir / "log");
+  ASSERT_EQ(r.status, 0) << r.err;
+  const auto rows = read_csv(dir / "out" / "diagnostics.csv");
+  ASSERT_EQ(rows.size(), 32u);  // header, steps 0, 10, ..., 300
+  const auto& head = rows[0];
+  const auto& last = rows.back();
+  const double q = std::stod(last[column(head, "flow_rate")]);
+  const double exact = std::stod(last[column(head, "poiseuille_flow_rate")]);
+  const double mu_app = std::stod(last[column(head, "relative_viscosity")]);
+  EXPECT_NEAR(exact, M_PI * 1e5 * std::pow(4e-6, 4) / (8 * 1.2e-3), 1e-25);
+  EXPECT_NEAR(q / exact, 1.0, 0.01);  // +0.09 % at D = 16h
+  EXPECT_NEAR(mu_app * q / exact, 1.0, 1e-12);
+  // Steady: the body force's work is the dissipation, and the kinetic energy no longer changes.
+  const double body = std::stod(last[column(head, "P_body")]), diss = std::stod(last[column(head, "dissipation")]);
+  EXPECT_NEAR(diss / body, 1.0, 1e-6);
+  const auto& before = rows[rows.size() - 2];
+  EXPECT_NEAR(std::stod(before[column(head, "flow_rate")]) / q, 1.0, 1e-9);
+}
+
+TEST(TubeFlow, RestartContinuesBitwise) {
+  ScratchDir dir("tube_restart");
+  const std::vector<std::string> sets{"output.fields_every=0", "output.checkpoint_every=20", "time.end=1.6e-5"};
+  auto half = sets;
+  half.back() = "time.end=8e-6";
+  ASSERT_EQ(run_immerse(run_args(scenario_file("tube_flow.toml"), dir / "whole", sets), dir / "a").status, 0);
+  ASSERT_EQ(run_immerse(run_args(scenario_file("tube_flow.toml"), dir / "half", half), dir / "b").status, 0);
+  const auto r = run_immerse(
+      run_args(scenario_file("tube_flow.toml"), dir / "rest", sets, dir / "half" / "checkpoint.h5"), dir / "c");
+  ASSERT_EQ(r.status, 0) << r.err;
+  const auto whole = without_wall_clock(read_csv(dir / "whole" / "diagnostics.csv"));
+  const auto rest = without_wall_clock(read_csv(dir / "rest" / "diagnostics.csv"));
+  ASSERT_GE(rest.size(), 2u);
+  EXPECT_EQ(rest.back(), whole.back());
+}
+
+struct BadWall {
+  std::string name;
+  std::vector<std::string> sets;
+  std::string message;
+};
+
+void PrintTo(const BadWall& b, std::ostream* os) { *os << b.name; }
+
+class TubeFlowBadInput : public ::testing::TestWithParam<BadWall> {};
+
+TEST_P(TubeFlowBadInput, ExitsWithStatus2AndOneLineBeforeWritingAnything) {
+  const BadWall& b = GetParam();
+  ScratchDir dir("tube_bad_" + b.name);
+  fs::path file = scenario_file("tube_flow.toml");
+  if (b.name == "membrane_inside_wall" || b.name == "membrane_near_wall") {
+    file = dir / "tube_cell.toml";
+    std::ofstream f(file);
+    f << read_text(scenario_file("tube_flow.toml"))
+      << "\n[[membrane]]\nshape = \"sphere\"\nradius = 4e-7\nmesh.level = 1\n"
+      << (b.name == "membrane_inside_wall" ? "center = [5e-7, 5e-7, 1e-6]\n" : "center = [5e-6, 1.6e-6, 1e-6]\n");
+  }
+  const auto r = run_immerse(run_args(file, dir / "out", b.sets), dir / "log");
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_NE(r.err.find(b.message), std::string::npos) << r.err;
+  EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+  EXPECT_FALSE(fs::exists(dir / "out"));
+}
+
+INSTANTIATE_TEST_SUITE_P(Walls, TubeFlowBadInput,
+                         ::testing::Values(BadWall{"wall_axis_not_periodic",
+                                                   {"boundary.z=\"wall\""},
+                                                   "boundary.z = \"wall\": [[wall]] needs a box periodic along "
+                                                   "every axis"},
+                                           BadWall{"tube_does_not_close",
+                                                   {"wall[0].axis=[0.1234567,0,1]"},
+                                                   "wall[0].axis = [0.123457, 0, 1]: a tube must close on itself "
+                                                   "across the box"},
+                                           BadWall{"tube_meets_its_image",
+                                                   {"wall[0].radius=5.5e-6"},
+                                                   "wall[0].radius = 5.5e-06: the tube meets its periodic image"},
+                                           BadWall{"wall_outside_the_box",
+                                                   {"wall[0].center=[5e-6,5e-6,3e-6]"},
+                                                   "wall[0].center = [5e-06, 5e-06, 3e-06]: must lie in the box"},
+                                           BadWall{"tube_flow_without_a_tube",
+                                                   {"wall[0].shape=\"sphere\"", "wall[0].radius=1e-6"},
+                                                   "wall[0].shape: must be \"tube\" for scenario.kind = "
+                                                   "\"tube_flow\""},
+                                           BadWall{"flow_rate_with_walls",
+                                                   {"fluid.flow_rate=[0,0,1e-15]"},
+                                                   "fluid.flow_rate: must be zero with [[wall]] shapes"},
+                                           BadWall{"membrane_inside_wall", {}, "membrane[0] starts inside a [[wall]]"},
+                                           BadWall{"membrane_near_wall", {}, "membrane[0] comes within"}),
+                         [](const ::testing::TestParamInfo<BadWall>& p) { return p.param.name; });
+
+}  // namespace
