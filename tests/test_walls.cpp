@@ -126,8 +126,8 @@ TEST(WallGeometry, RefusesShapesThatDoNotFitTheBox) {
   EXPECT_THROW(GhostCellWalls(walled, WallGeometry({tube({2, 2, 1}, {0, 0, 1}, 1)}, g)), InputError);
 }
 
-// Every row of the system the solve answers: the cut (Shortley–Weller) rows at the cut points, the periodic rows with
-// the right-hand side elsewhere in the fluid and with 0 in the wall.
+// Every row of the system the solve answers: the cut (Shortley–Weller) rows at the cut points, the periodic rows
+// elsewhere in the fluid, and 0 in the wall.
 TEST(GhostCellWalls, SolvesItsRowsToRoundOff) {
   const Grid g({20, 18, 6}, {1.0, 0.9, 0.3}, {P, P, P});
   const WallGeometry w({tube({0.5, 0.45, 0.1}, {0, 0, 1}, 0.37), sphere({0.5, 0.45, 0.15}, 0.11)}, g);
@@ -165,7 +165,10 @@ TEST(GhostCellWalls, SolvesItsRowsToRoundOff) {
           const double lap = (at(i - 1, j, k) + at(i + 1, j, k) + at(i, j - 1, k) + at(i, j + 1, k) + at(i, j, k - 1) +
                               at(i, j, k + 1) - 6 * at(i, j, k)) *
                              inv_h2;
-          worst = std::max(worst, std::abs(alpha * x(i, j, k) + beta * lap - (fluid ? b(i, j, k) : 0.0)));
+          if (fluid)
+            worst = std::max(worst, std::abs(alpha * x(i, j, k) + beta * lap - b(i, j, k)));
+          else
+            EXPECT_EQ(x(i, j, k), 0.0);  // the wall's velocity
         }
     EXPECT_EQ(cut, walls.cut_count(d));
     EXPECT_LE(worst, 1e-10) << d;
@@ -194,7 +197,7 @@ TEST(TubeFlow, PoiseuilleFlowRateAndItsOrderUnderRefinement) {
 
 // The same tube at 30° to z (axis along (Lx, 0, Lz), Lx/Lz = 15/26): D = 16h, within 1 %.
 TEST(TubeFlow, AtThirtyDegreesToTheGrid) {
-  const TubeResult res = tube_flow(8, 30, 20, 52, 1, 1000);
+  const TubeResult res = tube_flow(8, 30, 20, 52, 1, 1000);  // steady to 1e-6: -2.744e-3 after 4000 steps
   const double error = res.flow_rate / res.exact - 1;
   std::printf(
       "tube at %.2f degrees, R = 8h: flow rate / (pi G R^4 / 8 mu) - 1 "
@@ -216,7 +219,7 @@ struct DragResult {
 // mean pressure gradient's force balance), and Zick & Homsy's K = F / (6πμ a U) with U the superficial velocity
 // (1/L³) ∫_fluid u_x dV. The steady state by steps cycling through ν Δt = 4^k h², k = 0 … 5, which damp every mode
 // (Crank–Nicolson with ν Δt λ/2 within a factor 2 of 1 divides it by 3 or more), until U changes by less than 1e-10
-// of itself over a cycle. ρ = 1e-3 μ L / U: a Reynolds number about 1e-5.
+// of itself over a cycle, or for 100 cycles (U then changes by about 1e-7 of itself per cycle, some 1e-6 in all). ρ = 1e-3 μ L / U: a Reynolds number about 1e-5.
 DragResult sphere_array(int n, double c) {
   const double h = 1.0 / n;
   const Grid g({n, n, n}, {1.0, 1.0, 1.0}, {P, P, P});
@@ -238,7 +241,7 @@ DragResult sphere_array(int n, double c) {
   };
   double U = 0;
   long steps = 0;
-  for (int cycle = 0; cycle < 200; ++cycle) {
+  for (int cycle = 0; cycle < 100; ++cycle) {
     for (int k = 0; k < 6; ++k, ++steps) {
       ns.step(s, FaceField(g), std::pow(4.0, k) * h * h * prm.rho / prm.mu, next);
       std::swap(s, next);

@@ -188,7 +188,10 @@ void GhostCellWalls::solve(int d, Array3& x, double alpha, double beta, FftHelmh
   for (int i = 0; i < n; ++i) rhs_[i] = u[c.cut[i]];  // b at the cut rows
   for (const std::size_t f : c.solid) u[f] = 0.0;
   fast.solve(x, alpha, beta);  // v = H⁻¹ b
-  if (n == 0) return;
+  if (n == 0) {
+    for (const std::size_t f : c.solid) u[f] = 0.0;
+    return;
+  }
   for (int i = 0; i < n; ++i) rhs_[i] = row_times(c, i, u) - rhs_[i];  // Wᵀ v = a v − b
   const int one = 1;
   int info = 0;
@@ -200,6 +203,7 @@ void GhostCellWalls::solve(int d, Array3& x, double alpha, double beta, FftHelmh
   const std::vector<double>& v = scratch_.values();
   std::vector<double>& out = x.values();
   for (std::size_t f = 0; f < out.size(); ++f) out[f] = v[f] - out[f];
+  for (const std::size_t f : c.solid) u[f] = 0.0;  // the wall's velocity: no flux through it in D u*
 }
 
 void GhostCellWalls::add_explicit_correction(int d, const Array3& un, double c, Array3& rhs) const {
