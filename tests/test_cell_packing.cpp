@@ -14,6 +14,7 @@
 #include "immerse/membrane/Geometry.hpp"
 #include "immerse/membrane/MeshGenerator.hpp"
 #include "immerse/membrane/Shape.hpp"
+#include "immerse/walls/WallGeometry.hpp"
 #include "test_run_support.hpp"
 
 using namespace immerse;
@@ -39,6 +40,26 @@ struct SphereBox {
 };
 
 }  // namespace
+
+// 12 spheres in a tube of radius 2.6 along z ([[wall]]): every node at least the clearance inside the tube, no two
+// copies closer than it; the start size and the volume fraction are the tube's.
+TEST(CellPacking, SpheresInATube) {
+  const SphereBox s(Boundary::Periodic);
+  PackingRequest r;
+  r.count = 12;
+  r.seed = 5;
+  r.clearance = 0.3;
+  r.walls = std::make_shared<const WallGeometry>(
+      std::vector<WallShape>{{WallShape::Kind::Tube, {4, 4, 4}, {0, 0, 1}, 2.6, 0, "wall[0]"}}, s.grid);
+  const auto X = s.place(r);
+  ASSERT_EQ(X.size(), 12u);  // 12 unit spheres: 30 % of the tube's 170
+  EXPECT_FALSE(closest_foreign_nodes(s.grid, X, r.clearance).has_value());
+  double nearest = 1e9;
+  for (const auto& cell : X)
+    for (const auto& p : cell) nearest = std::min(nearest, r.walls->distance(p));
+  EXPECT_GE(nearest, r.clearance);
+  EXPECT_NEAR(r.walls->fluid_volume(s.grid), M_PI * 2.6 * 2.6 * 8, 0.01 * M_PI * 2.6 * 2.6 * 8);
+}
 
 // 30 spheres (volume fraction 0.25) between walls z = 0 and z = 8: every pair of nodes of two spheres at least the
 // clearance apart (minimum images across the periodic sides), every node at least the clearance from the walls,

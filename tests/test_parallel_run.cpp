@@ -231,7 +231,7 @@ TEST(ParallelRun, RedCellChannelWithContactAcrossProcessesEqualsTheOneProcessRun
       c = c / double(Xm.size());
       owner.push_back(std::clamp(int(std::floor((c.z - g.origin().z) / g.h())), 0, g.n(2) - 1) / block);
     }
-    ContactForce contact(g, {1.5e-6, 1.0, false}, offsets, std::vector<double>(offsets.size() - 1, 1.0));
+    ContactForce contact(g, {1.5e-6, 1.0, false, {}}, offsets, std::vector<double>(offsets.size() - 1, 1.0));
     const auto near = contact.neighbours(X);
     std::size_t pairs = 0, across = 0;
     for (std::size_t i = 0; i < X.size(); ++i) {

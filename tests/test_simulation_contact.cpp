@@ -14,6 +14,7 @@
 #include "immerse/scenario/Scenario.hpp"
 #include "immerse/simulation/Parameters.hpp"
 #include "immerse/simulation/Simulation.hpp"
+#include "immerse/walls/WallGeometry.hpp"
 #include "PetscEnvironment.hpp"
 #include "test_run_support.hpp"
 
@@ -38,7 +39,7 @@ struct Cloud {
     for (std::size_t i = 0; i < offsets.back(); ++i) X.push_back({8 * U(rng) - 0.5, 10 * U(rng) + 0.3, 6 * U(rng)});
   }
   ContactForce contact(double range, bool walls = true) const {
-    return ContactForce(grid, {range, 0.7, walls}, offsets, {2.0, 3.0, 5.0});
+    return ContactForce(grid, {range, 0.7, walls, {}}, offsets, {2.0, 3.0, 5.0});
   }
 };
 
@@ -74,7 +75,7 @@ TEST(ContactForce, ForceAndItsDerivativeVanishAtTheRange) {
   EXPECT_LT(ContactForce::pair_force_shape(d - step, d) / step, 1e-5);
   // Two nodes of different membranes just beyond d (and far from the walls): exactly zero.
   const Grid g({10, 10, 10}, {1.0, 1.0, 1.0}, {W, W, W});
-  ContactForce contact(g, {d, 1.0, true}, {0, 1, 2}, {1.0, 1.0});
+  ContactForce contact(g, {d, 1.0, true, {}}, {0, 1, 2}, {1.0, 1.0});
   std::vector<Vec3> X{{0.5, 0.5, 0.35}, {0.5, 0.5, 0.35 + d * (1 + 1e-12)}}, F(2);
   contact.compute(X, F);
   EXPECT_EQ(xyz(F[0]), kZero);
@@ -83,7 +84,7 @@ TEST(ContactForce, ForceAndItsDerivativeVanishAtTheRange) {
 
 TEST(ContactForce, PairForcesAreEqualAndOppositeAcrossAPeriodicEnd) {
   const Grid g({10, 10, 10}, {1.0, 1.0, 1.0}, {P, P, P});
-  ContactForce contact(g, {0.2, 1.5, true}, {0, 1, 2}, {2.0, 4.0});
+  ContactForce contact(g, {0.2, 1.5, true, {}}, {0, 1, 2}, {2.0, 4.0});
   // 0.06 apart through the periodic end of x, offset along y and z.
   std::vector<Vec3> X{{0.98, 0.5, 0.5}, {0.02, 0.53, 0.49}}, F(2);
   contact.compute(X, F);
@@ -105,7 +106,7 @@ TEST(ContactForce, PairForcesAreEqualAndOppositeAcrossAPeriodicEnd) {
 
 TEST(ContactForce, WallForceIsNormalToTheWallAndPointsInside) {
   const Grid g({10, 10, 10}, {1.0, 1.0, 1.0}, {P, W, P});
-  ContactForce contact(g, {0.1, 2.0, true}, {0, 2}, {3.0});
+  ContactForce contact(g, {0.1, 2.0, true, {}}, {0, 2}, {3.0});
   std::vector<Vec3> X{{0.3, 0.04, 0.7}, {0.6, 0.97, 0.2}}, F(2);
   contact.compute(X, F);
   EXPECT_EQ(F[0].x, 0.0);
@@ -114,7 +115,36 @@ TEST(ContactForce, WallForceIsNormalToTheWallAndPointsInside) {
   EXPECT_EQ(F[1].x, 0.0);
   EXPECT_EQ(F[1].z, 0.0);
   EXPECT_DOUBLE_EQ(F[1].y, -2.0 * 3.0 * 0.1 * 0.7 * 0.7);
-  ContactForce off(g, {0.1, 2.0, false}, {0, 2}, {3.0});
+  ContactForce off(g, {0.1, 2.0, false, {}}, {0, 2}, {3.0});
+  off.compute(X, F);
+  EXPECT_EQ(xyz(F[0]), kZero);
+}
+
+// A tube of radius 1 along z ([[wall]]): nodes within the range of its surface are pushed towards the axis by the law
+// of s = R − r, the force minus the energy's gradient; a node near the axis feels nothing.
+TEST(ContactForce, CurvedWallPushesNodesAlongItsNormalIntoTheFluid) {
+  const Grid g({12, 12, 6}, {3.0, 3.0, 1.5}, {P, P, P});
+  ContactSettings settings{0.2, 2.0, true, {}};
+  settings.shapes = std::make_shared<const WallGeometry>(
+      std::vector<WallShape>{{WallShape::Kind::Tube, {1.5, 1.5, 0.75}, {0, 0, 1}, 1.0, 0, "wall[0]"}}, g);
+  ContactForce contact(g, settings, {0, 3}, {3.0});
+  const double c = std::sqrt(0.5);
+  std::vector<Vec3> X{{1.5 + 0.9 * c, 1.5 + 0.9 * c, 0.3}, {1.5, 1.5 - 1.05, 1.0}, {1.6, 1.5, 0.2}}, F(3);
+  contact.compute(X, F);
+  const double f0 = 2.0 * 3.0 * 0.2 * 0.5 * 0.5;  // s = 0.1: (1 − s/d)² = 1/4
+  EXPECT_NEAR(F[0].x, -f0 * c, 1e-14);
+  EXPECT_NEAR(F[0].y, -f0 * c, 1e-14);
+  EXPECT_EQ(F[0].z, 0.0);
+  EXPECT_NEAR(F[1].y, 2.0 * 3.0 * 0.2 * 1.25 * 1.25, 1e-13);  // 0.05 inside the wall: s = −0.05, still pushed out
+  EXPECT_EQ(xyz(F[2]), kZero);
+  for (std::size_t i = 0; i < 2; ++i)
+    for (int k = 0; k < 2; ++k) {
+      auto Xp = X, Xm = X;
+      Xp[i][k] += 1e-6;
+      Xm[i][k] -= 1e-6;
+      EXPECT_NEAR(-(contact.energy(Xp) - contact.energy(Xm)) / 2e-6, F[i][k], 1e-7) << i << " " << k;
+    }
+  ContactForce off(g, {0.2, 2.0, false, settings.shapes}, {0, 3}, {3.0});
   off.compute(X, F);
   EXPECT_EQ(xyz(F[0]), kZero);
 }
@@ -160,7 +190,7 @@ TEST(ContactForce, BoundingBoxesKeepEveryPairOfCompactMembranes) {
     return std::upper_bound(offsets.begin(), offsets.end(), n) - offsets.begin();
   };
   for (double range : {0.3, 1.0}) {
-    ContactForce contact(grid, {range, 1.0, false}, offsets, std::vector<double>(offsets.size() - 1, 1.0));
+    ContactForce contact(grid, {range, 1.0, false, {}}, offsets, std::vector<double>(offsets.size() - 1, 1.0));
     const auto fast = contact.neighbours(X);
     std::size_t pairs = 0;
     for (std::size_t i = 0; i < X.size(); ++i) {
@@ -176,8 +206,8 @@ TEST(ContactForce, BoundingBoxesKeepEveryPairOfCompactMembranes) {
 
 TEST(ContactForce, RangeMustBeBelowHalfThePeriodicLength) {
   const Grid g({10, 10, 10}, {1.0, 1.0, 1.0}, {P, W, W});
-  EXPECT_THROW(ContactForce(g, {0.5, 1.0, true}, {0, 1}, {1.0}), InputError);
-  EXPECT_NO_THROW(ContactForce(g, {0.49, 1.0, true}, {0, 1}, {1.0}));
+  EXPECT_THROW(ContactForce(g, {0.5, 1.0, true, {}}, {0, 1}, {1.0}), InputError);
+  EXPECT_NO_THROW(ContactForce(g, {0.49, 1.0, true, {}}, {0, 1}, {1.0}));
 }
 
 TEST(ContactForce, AreaModulusOfEachLaw) {

@@ -7,6 +7,7 @@
 
 #include "immerse/contact/MembraneClearance.hpp"
 #include "immerse/core/Error.hpp"
+#include "immerse/walls/WallGeometry.hpp"
 
 namespace immerse {
 namespace {
@@ -99,9 +100,9 @@ std::string number(double v) {
 // The overdamped rigid-body relaxation of step 2 (see the header), at one size s of the copies.
 class Relaxation {
  public:
-  Relaxation(const Grid& grid, const std::vector<Vec3>& shape, double clearance, std::vector<Vec3>& centre,
-             std::vector<Quaternion>& orientation)
-      : grid_(grid), shape_(shape), c_(clearance), centre_(centre), orientation_(orientation), N_(centre.size()) {
+  Relaxation(const Grid& grid, const WallGeometry* walls, const std::vector<Vec3>& shape, double clearance,
+             std::vector<Vec3>& centre, std::vector<Quaternion>& orientation)
+      : grid_(grid), walls_(walls), shape_(shape), c_(clearance), centre_(centre), orientation_(orientation), N_(centre.size()) {
     double sum = 0;
     for (const auto& p : shape) R_ = std::max(R_, norm(p)), sum += dot(p, p);
     mean_r2_ = sum / static_cast<double>(shape.size());
@@ -244,11 +245,23 @@ class Relaxation {
           F[i] += f, T[i] += cross(arm_[i][k], f);
         }
       }
+    if (walls_)
+      for (std::size_t i = 0; i < N_; ++i) {
+        if (walls_->distance(centre_[i]) > R_ + target) continue;
+        for (std::size_t k = 0; k < shape_.size(); ++k) {
+          const double gap = walls_->distance(X_[i][k]);
+          if (gap >= target) continue;
+          clear = clear && gap >= c_;
+          const Vec3 f = (target - gap) * walls_->normal(X_[i][k]);
+          F[i] += f, T[i] += cross(arm_[i][k], f);
+        }
+      }
     for (std::size_t i = 0; i < N_; ++i) G[i] = T[i] / sqrtI;
     return clear;
   }
 
   const Grid& grid_;
+  const WallGeometry* walls_;  // the [[wall]] shapes, or null
   const std::vector<Vec3>& shape_;
   const double c_;
   std::vector<Vec3>& centre_;
@@ -281,9 +294,18 @@ CellPacking::CellPacking(const Grid& grid, const std::vector<Vec3>& shape, doubl
     lo[a] = grid.origin()[a];
     span[a] = grid.length(a);
   }
-  // Start size: bounding spheres (with half the clearance) filling kStartFill of the box.
+  // Start size: bounding spheres (with half the clearance) filling kStartFill of the box's fluid, each fitting
+  // where the fluid is widest.
+  if (request.walls) box = request.walls->fluid_volume(grid);
   const double r_start = std::cbrt(kStartFill * box / (4.0 / 3.0 * M_PI * static_cast<double>(N))) - c / 2;
   double s = std::min(1.0, r_start / R);
+  if (request.walls) {
+    double widest = 0;
+    for (int k = 0; k < grid.n(2); ++k)
+      for (int j = 0; j < grid.n(1); ++j)
+        for (int i = 0; i < grid.n(0); ++i) widest = std::max(widest, request.walls->distance(grid.cell_position(i, j, k)));
+    s = std::min(s, 0.9 * (widest - c) / R);
+  }
   if (s < 0.05)
     throw InputError(std::string(key) + ": " + std::to_string(N) + " copies of the template membrane (bounding radius " +
                      number(R) + " m) cannot start small enough in this box with clearance " + number(c) + " m");
@@ -307,7 +329,8 @@ CellPacking::CellPacking(const Grid& grid, const std::vector<Vec3>& shape, doubl
           throw InputError(std::string(key) + ": the box is too small along " + "xyz"[a] + " for one copy of the template membrane");
         p[a] = from + (to - from) * rng.uniform();
       }
-      placed = std::all_of(centre.begin(), centre.begin() + static_cast<long>(i),
+      placed = (!request.walls || request.walls->distance(p) >= s * R + c) &&
+               std::all_of(centre.begin(), centre.begin() + static_cast<long>(i),
                            [&](const Vec3& q) { return norm(minimum_image(grid, p, q)) >= 2 * s * R + c; });
       if (placed) centre[i] = p;
     }
@@ -319,7 +342,7 @@ CellPacking::CellPacking(const Grid& grid, const std::vector<Vec3>& shape, doubl
   // 2. Grow and relax. A size that does not relax within kMaxIterations steps is stepped back to the last clear size
   // times 1 + g/2 (the copies keep their places) and the growth step g halves; the copies are jammed when g falls
   // below kGrowthMin or when a size fails after kMaxTotal steps in all.
-  Relaxation relaxation(grid, shape, c, centre, orientation);
+  Relaxation relaxation(grid, request.walls.get(), shape, c, centre, orientation);
   double growth = std::min(kGrowthMax, kMaxStep * c / R), s_clear = s;  // a growth step moves nodes <= kMaxStep c
   while (true) {
     double next = 1;

@@ -6,10 +6,12 @@
 // 68:011306):
 //
 //   1. every copy i gets a uniformly random orientation q_i (Shoemake 1992 quaternions) and is placed at scale s0 by
-//      random sequential addition, its bounding sphere clear of the others' and of the walls;
+//      random sequential addition, its bounding sphere clear of the others' and of the walls (a [[wall]] shape's too:
+//      φ(c_i) at least the bounding radius plus c; the start scale from the fluid's volume);
 //   2. at scale s copy i has the nodes x_ik = c_i + s R(q_i) p_k. Every pair of nodes of two copies closer than
 //      c* = 1.05 c (minimum images on periodic axes), and every node closer than c* to a wall, repels with
-//      f = (c* - d) n (n the unit vector between the nodes, or the wall's normal): the force of the energy
+//      f = (c* - d) n (n the unit vector between the nodes, or the wall's normal; ∇φ for a [[wall]] shape, d = φ):
+//      the force of the energy
 //      U = 1/2 sum (c* - d)^2. The forces sum into F_i = sum f and torques T_i = sum (x_ik - c_i) x f about the
 //      centres, and the copies move as rigid bodies of unit mass and moment of inertia I = s^2 <|p_k|^2> down U
 //      by FIRE (Bitzek et al. 2006, Phys. Rev. Lett. 97:170201): velocities dv_i = F_i dt and d(omega_i) = T_i/I dt,
@@ -29,9 +31,10 @@
 // their top 53 bits.
 // Verified by the tests CellPacking.* (red cells at a volume fraction of 0.4 in a periodic box and between walls: no
 // pair within the clearance, no node inside another copy, no elements crossing, bitwise reproducible by seed; a
-// fraction that cannot be reached is refused).
+// fraction that cannot be reached is refused) and CellPacking.SpheresInATube (every node clear of a tube's wall).
 #include <cstdint>
 #include <functional>
+#include <memory>
 #include <vector>
 
 #include "immerse/grid/Grid.hpp"
@@ -39,10 +42,14 @@
 
 namespace immerse {
 
+class WallGeometry;
+
 struct PackingRequest {
   std::size_t count = 0;      ///< copies to place
   std::uint64_t seed = 1;
   double clearance = 0;       ///< least distance between nodes of two copies, and from a node to a wall (m)
+  /// The [[wall]] shapes (null: none): the copies are placed in their fluid, no node closer than the clearance to them.
+  std::shared_ptr<const WallGeometry> walls;
   /// Asked between relaxation steps (when set): true ends the packing with StopRequested, nothing placed.
   std::function<bool()> stop_requested;
 };

@@ -7,6 +7,7 @@
 #include "immerse/contact/MembraneClearance.hpp"
 #include "immerse/core/Error.hpp"
 #include "immerse/core/ThreadThresholds.hpp"
+#include "immerse/walls/WallGeometry.hpp"
 
 namespace immerse {
 
@@ -166,6 +167,9 @@ void ContactForce::compute(std::span<const Vec3> X, std::span<Vec3> F) {
         const double lower = X[i][k] - grid_.origin()[k], upper = grid_.origin()[k] + grid_.length(k) - X[i][k];
         f[k] += scale(a, a) * (pair_force_shape(lower, d) - pair_force_shape(upper, d));
       }
+    if (settings_.walls && settings_.shapes)
+      if (const double s = settings_.shapes->distance(X[i]); s < d)
+        f += (scale(a, a) * pair_force_shape(s, d)) * settings_.shapes->normal(X[i]);
     F[i] = f;
   }
 }
@@ -186,6 +190,7 @@ double ContactForce::energy(std::span<const Vec3> X) {
       for (int k = 0; k < 3; ++k)
         if (!grid_.periodic(k))
           E += scale(a, a) * (U(X[i][k] - grid_.origin()[k]) + U(grid_.origin()[k] + grid_.length(k) - X[i][k]));
+    if (settings_.walls && settings_.shapes) E += scale(a, a) * U(settings_.shapes->distance(X[i]));
   }
   return E;
 }

@@ -10,7 +10,8 @@
 //
 // F and dF/dr vanish at r = d, so the force and its Jacobian are continuous there (Newton's iterations see no kink).
 //   r    distance of node i of membrane a to node j of another membrane b, by the minimum image along periodic axes
-//   s    distance of a node of membrane a to a wall; the wall pushes along its inward normal
+//   s    distance of a node of membrane a to a wall; the wall pushes along its inward normal (for a [[wall]] shape,
+//        s = φ(X) and the normal ∇φ of WallGeometry)
 //   d    contact.range (m; default the grid spacing h, at which the delta function of eq. (8) starts to merge
 //        the two membranes' forces)
 //   eps  contact.strength (dimensionless; default 1)
@@ -27,12 +28,13 @@
 // most a few per node, so memory and cost are linear in the nodes), rebuilt at every evaluation. Each node sums the forces of its own neighbours in a fixed order (bins,
 // then node index): the sums do not depend on the thread count. With no node within d of another membrane or a
 // wall every force is exactly zero, and the run is bitwise that without contact.
-// Verified by tests/test_simulation_contact.cpp (ContactForce.*: gradient, support, third law, walls, neighbour
+// Verified by tests/test_simulation_contact.cpp (ContactForce.*: gradient, support, third law, walls, curved walls, neighbour
 // search against brute force; ContactRun.*: two capsules kept apart in shear, an isolated capsule unchanged) and
 // ParallelRun.* (bounds(), boxes_within_range() and set_search_nodes() on part of the membranes, in
 // DistributedOperator: the forces of a distributed run equal the one-process run's).
 #include <array>
 #include <cstddef>
+#include <memory>
 #include <span>
 #include <vector>
 
@@ -42,10 +44,14 @@
 
 namespace immerse {
 
+class WallGeometry;
+
 struct ContactSettings {
   double range = 0;     ///< d (m); 0 switches contact off
   double strength = 1;  ///< eps (dimensionless)
-  bool walls = true;    ///< node-wall repulsion on the wall axes
+  bool walls = true;    ///< node-wall repulsion on the wall axes and from the [[wall]] shapes
+  /// The [[wall]] shapes (null: none): with `walls`, a node at distance s = φ(X) < d from them is pushed along ∇φ.
+  std::shared_ptr<const WallGeometry> shapes;
 };
 
 /// K_s = (1/2) d tau / d lambda at lambda = 1 of the isotropic tension (MaterialLaw.hpp) of the law without its

@@ -92,7 +92,9 @@ FluidParams run_fluid_params(const io::Config& c) {
 }
 
 ContactSettings run_contact_settings(const io::Config& c) {
-  return {c.get<double>("contact.range"), c.get<double>("contact.strength"), c.get<bool>("contact.walls")};
+  ContactSettings s{c.get<double>("contact.range"), c.get<double>("contact.strength"), c.get<bool>("contact.walls"), {}};
+  if (s.walls && c.count("wall") > 0) s.shapes = run_fluid_params(c).walls;
+  return s;
 }
 
 SolverSettings run_solver_settings(const io::Config& c) {

@@ -233,9 +233,11 @@ void Builder::pack_membranes() {
   for (const auto& e : tmpl.elements)
     for (const auto& [a, b] : {std::pair{0, 3}, {3, 1}, {1, 4}, {4, 2}, {2, 5}, {5, 0}})
       spacing = std::max(spacing, norm(shape[e[a]] - shape[e[b]]));
-  double box = 1;
-  for (int a = 0; a < 3; ++a) box *= grid_.length(a);
   PackingRequest request;
+  if (config_.count("wall") > 0) request.walls = run_fluid_params(config_).walls;
+  double box = 1;  // the fluid's volume
+  for (int a = 0; a < 3; ++a) box *= grid_.length(a);
+  if (request.walls) box = request.walls->fluid_volume(grid_);
   request.count = count > 0 ? static_cast<std::size_t>(count) : static_cast<std::size_t>(std::llround(fraction * box / g.volume));
   if (request.count == 0)
     throw InputError("packing.volume_fraction = " + config_.value_text("packing.volume_fraction") +
@@ -247,7 +249,7 @@ void Builder::pack_membranes() {
   const auto t0 = std::chrono::steady_clock::now();
   const CellPacking packing(grid_, shape, spacing, request, key);
   std::ostringstream summary;
-  summary << "packing: " << request.count << " copies of membrane[0], volume fraction "
+  summary << "packing: " << request.count << " copies of membrane[0], volume fraction " << (request.walls ? "of the fluid " : "")
           << static_cast<double>(request.count) * g.volume / box << " (seed " << request.seed << "), in "
           << std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count() << " s";
   packing_summary_ = summary.str();

@@ -147,4 +147,14 @@ Vec3 WallGeometry::normal(const Vec3& x) const {
   return n;
 }
 
+double WallGeometry::fluid_volume(const Grid& grid) const {
+  const double q = 0.5 * grid.h();
+  std::size_t inside = 0;
+  for (int k = 0; k < 2 * grid.n(2); ++k)
+    for (int j = 0; j < 2 * grid.n(1); ++j)
+      for (int i = 0; i < 2 * grid.n(0); ++i)
+        inside += distance(grid.origin() + Vec3{(i + 0.5) * q, (j + 0.5) * q, (k + 0.5) * q}) > 0;
+  return static_cast<double>(inside) * q * q * q;
+}
+
 }  // namespace immerse

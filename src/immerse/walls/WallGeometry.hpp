@@ -42,6 +42,9 @@ class WallGeometry {
 
   const std::vector<WallShape>& shapes() const { return shapes_; }
 
+  /// The fluid's volume in the box of `grid` (m³): the points with φ > 0 of a lattice of spacing h/2.
+  double fluid_volume(const Grid& grid) const;
+
  private:
   /// φ of one shape at x (nearest periodic image) and its gradient.
   double shape_distance(const WallShape& s, const Vec3& x, Vec3& grad) const;
