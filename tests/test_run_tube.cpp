@@ -40,6 +40,22 @@ TEST(TubeFlow, ScenarioReachesPoiseuilleFlowRate) {
   EXPECT_NEAR(std::stod(before[column(head, "flow_rate")]) / q, 1.0, 1e-9);
 }
 
+// fluid.initial = "poiseuille" in a tube: the steady flow of the cut-cell step from step 0 (the flow rate of the run
+// from rest at its end, and unchanged by the steps).
+TEST(TubeFlow, PoiseuilleInitialFlowIsTheSteadyState) {
+  ScratchDir dir("tube_poiseuille");
+  const auto r = run_immerse(run_args(scenario_file("tube_flow.toml"), dir / "out",
+                                      {"fluid.initial=\"poiseuille\"", "time.end=4e-6", "output.diagnostics_every=1",
+                                       "output.fields_every=0"}),
+                             dir / "log");
+  ASSERT_EQ(r.status, 0) << r.err;
+  const auto rows = read_csv(dir / "out" / "diagnostics.csv");
+  ASSERT_EQ(rows.size(), 12u);
+  const std::size_t q = column(rows[0], "flow_rate");
+  for (std::size_t i = 1; i < rows.size(); ++i)
+    EXPECT_NEAR(std::stod(rows[i][q]) / 8.3854166666660729e-15, 1.0, 1e-11) << i;  // the run from rest at t = 0.12 ms
+}
+
 TEST(TubeFlow, RestartContinuesBitwise) {
   ScratchDir dir("tube_restart");
   const std::vector<std::string> sets{"output.fields_every=0", "output.checkpoint_every=20", "time.end=1.6e-5"};

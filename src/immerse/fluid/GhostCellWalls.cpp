@@ -223,30 +223,67 @@ void GhostCellWalls::add_explicit_correction(int d, const Array3& un, double c, 
   }
 }
 
-FluidEnergy GhostCellWalls::energy(const FluidParams& params, const FaceField& u) const {
+void GhostCellWalls::laplacian(int d, const Array3& u, Array3& out) const {
+  const Component& c = comp_[d];
   const LatticeIndex L{grid_.n()};
-  const double h3 = grid_.h() * grid_.h() * grid_.h(), inv_h2 = 1.0 / (grid_.h() * grid_.h());
+  const double inv_h2 = 1.0 / (grid_.h() * grid_.h());
+  const double* const v = u.data();
+  double* const o = out.data();
+  for (std::size_t f = 0; f < u.size(); ++f) {
+    if (!c.fluid[f]) {
+      o[f] = 0;
+      continue;
+    }
+    const auto [x, y, z] = L.ijk(f);
+    o[f] = (v[L.flat(x - 1, y, z)] + v[L.flat(x + 1, y, z)] + v[L.flat(x, y - 1, z)] + v[L.flat(x, y + 1, z)] +
+            v[L.flat(x, y, z - 1)] + v[L.flat(x, y, z + 1)] - 6.0 * v[f]) * inv_h2;
+  }
+  for (std::size_t i = 0; i < c.cut.size(); ++i) {
+    double sum = 0;
+    for (std::size_t k = c.row_start[i]; k < c.row_start[i + 1]; ++k) sum += c.val[k] * v[c.col[k]];
+    o[c.cut[i]] = sum;
+  }
+}
+
+void GhostCellWalls::steady_flow(int d, double f, double mu, Array3& u, FftHelmholtzSolver& fast) {
+  const Component& c = comp_[d];
+  const double h = grid_.h();
+  std::fill(u.values().begin(), u.values().end(), 0.0);
+  if (f == 0) return;
+  // The slowest mode of −L_c: about (2.405/R)² for the widest circle R of fluid, below half the box's longest side.
+  double R = 0.5 * std::max({grid_.length(0), grid_.length(1), grid_.length(2)});
+  std::vector<double> alphas;
+  for (double a = 12 / (h * h); a > 0.25 * std::pow(2.405 / R, 2); a /= 4) alphas.push_back(a);
+  Array3 r(u.shape()[0], u.shape()[1], u.shape()[2]), lap = r;
+  const double target = 1e-12 * std::abs(f) / mu;
+  for (int cycle = 0; cycle < 200; ++cycle) {
+    for (const double alpha : alphas) {
+      laplacian(d, u, lap);
+      double worst = 0;
+      for (std::size_t q = 0; q < u.size(); ++q) {
+        r.data()[q] = c.fluid[q] ? -f / mu - lap.data()[q] : 0.0;
+        worst = std::max(worst, std::abs(r.data()[q]));
+      }
+      if (worst <= target) return;
+      solve(d, r, alpha, -1.0, fast);
+      for (std::size_t q = 0; q < u.size(); ++q) u.data()[q] -= r.data()[q];
+    }
+  }
+  throw SimulationError("GhostCellWalls::steady_flow: the iterations did not converge in 200 cycles");
+}
+
+FluidEnergy GhostCellWalls::energy(const FluidParams& params, const FaceField& u) const {
+  const double h3 = grid_.h() * grid_.h() * grid_.h();
   FluidEnergy e;
   for (int d = 0; d < 3; ++d) {
     const Component& c = comp_[d];
     const double* const v = u[d].data();
-    std::vector<double> lap(u[d].size(), 0.0);  // L_c u at the fluid points
-    for (std::size_t f = 0; f < lap.size(); ++f) {
-      if (!c.fluid[f]) continue;
-      const auto [x, y, z] = L.ijk(f);
-      lap[f] = (v[L.flat(x - 1, y, z)] + v[L.flat(x + 1, y, z)] + v[L.flat(x, y - 1, z)] + v[L.flat(x, y + 1, z)] +
-                v[L.flat(x, y, z - 1)] + v[L.flat(x, y, z + 1)] - 6.0 * v[f]) *
-               inv_h2;
-    }
-    for (std::size_t i = 0; i < c.cut.size(); ++i) {
-      double s = 0;
-      for (std::size_t k = c.row_start[i]; k < c.row_start[i + 1]; ++k) s += c.val[k] * v[c.col[k]];
-      lap[c.cut[i]] = s;
-    }
-    for (std::size_t f = 0; f < lap.size(); ++f) {
+    Array3 lap(u[d].shape()[0], u[d].shape()[1], u[d].shape()[2]);
+    laplacian(d, u[d], lap);
+    for (std::size_t f = 0; f < u[d].size(); ++f) {
       if (!c.fluid[f]) continue;
       e.kinetic += 0.5 * params.rho * v[f] * v[f] * h3;
-      e.dissipation -= params.mu * v[f] * lap[f] * h3;
+      e.dissipation -= params.mu * v[f] * lap.data()[f] * h3;
       e.body += params.body_force[d] * v[f] * h3;
     }
   }

@@ -59,6 +59,16 @@ class GhostCellWalls {
   /// built with the periodic ∇_h², taken with the cut rows' Laplacian L_c instead (c = μΔt/2ρ).
   void add_explicit_correction(int d, const Array3& un, double c, Array3& rhs) const;
 
+  /// L_c u for component d: the cut rows' Laplacian at the cut points, the 7-point one at the other fluid points, 0 at
+  /// the solid points.
+  void laplacian(int d, const Array3& u, Array3& out) const;
+
+  /// The steady flow of component d under the uniform body force f (N/m³): μ L_c u = −f at the fluid points, u = 0 in
+  /// the walls, by Richardson iterations u −= (α − L_c)⁻¹ (−f/μ − L_c u) with α cycling from 12/h² down by factors
+  /// of 4 to below (2.405/φ_max)²/4 (each mode is damped at least twofold by one of them in a cycle), until the
+  /// residual is below 1e-12 f/μ. `fast`: a periodic solver of component d.
+  void steady_flow(int d, double f, double mu, Array3& u, FftHelmholtzSolver& fast);
+
   /// The energy measures of u over the fluid points (docs/energy-budget.md, "Walls of any shape"): kinetic ρ/2 Σ u² h³,
   /// body f_body·Σ u h³ and dissipation −μ Σ u·(L_c u) h³ with the cut rows' Laplacian L_c (at a steady state the body
   /// force's work exactly); the rigid walls do no work.

@@ -6,10 +6,56 @@
 
 #include "immerse/core/Error.hpp"
 #include "immerse/fluid/FftHelmholtzSolver.hpp"
+#include "immerse/fluid/GhostCellWalls.hpp"
+#include "immerse/walls/WallGeometry.hpp"
 
 namespace immerse {
 
+namespace {
+
+// [[wall]] tubes along one grid axis a with the body force along it: the steady flow does not vary along a, so it is
+// solved on a section two cells long (GhostCellWalls::steady_flow) and repeated along a.
+void set_tube_poiseuille_flow(const Grid& grid, const FluidParams& params, FaceField& u) {
+  int a = -1;
+  for (int d = 0; d < 3; ++d)
+    if (params.body_force[d] != 0) {
+      require(a < 0, "fluid.body_force", "along one axis for fluid.initial = \"poiseuille\" with [[wall]] shapes");
+      a = d;
+    }
+  for (int d = 0; d < 3; ++d) std::fill(u[d].values().begin(), u[d].values().end(), 0.0);
+  if (a < 0) return;
+  std::vector<WallShape> section_shapes = params.walls->shapes();
+  std::array<int, 3> n = grid.n();
+  std::array<double, 3> length{};
+  n[a] = 2;
+  for (int d = 0; d < 3; ++d) length[d] = n[d] * grid.h();
+  for (WallShape& s : section_shapes) {
+    require(s.kind == WallShape::Kind::Tube && std::abs(s.axis[a]) == 1.0, s.name + ".axis",
+            std::string("along ") + axis_name(a) + ", the body force, for fluid.initial = \"poiseuille\" (tubes only)");
+    s.center[a] = grid.origin()[a] + grid.h();
+  }
+  const Grid section(n, length, {grid.bc(0), grid.bc(1), grid.bc(2)}, grid.origin());
+  GhostCellWalls walls(section, WallGeometry(section_shapes, section));
+  FftHelmholtzSolver fast(section, velocity_layout(a), FftPlanning::Estimate);
+  Array3 s(n[0], n[1], n[2]);
+  walls.steady_flow(a, params.body_force[a], params.mu, s, fast);
+  Array3& ua = u[a];
+  for (int k = 0; k < grid.n(2); ++k)
+    for (int j = 0; j < grid.n(1); ++j)
+      for (int i = 0; i < grid.n(0); ++i) {
+        std::array<int, 3> q{i, j, k};
+        q[a] = 0;
+        ua(i, j, k) = s(q[0], q[1], q[2]);
+      }
+}
+
+}  // namespace
+
 void set_poiseuille_flow(const Grid& grid, const FluidParams& params, FaceField& u) {
+  if (params.walls) {
+    set_tube_poiseuille_flow(grid, params, u);
+    return;
+  }
   bool walls = false;
   for (int d = 0; d < 3; ++d) {
     if (grid.periodic(d)) continue;

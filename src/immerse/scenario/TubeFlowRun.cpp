@@ -1,8 +1,11 @@
 #include "immerse/scenario/TubeFlowRun.hpp"
 
+#include <cmath>
+#include <limits>
 #include <numbers>
 
 #include "immerse/core/Error.hpp"
+#include "immerse/membrane/Geometry.hpp"
 #include "immerse/simulation/SimulationInterface.hpp"
 #include "immerse/walls/WallGeometry.hpp"
 
@@ -15,7 +18,11 @@ std::vector<Column> TubeFlowRun::run_columns() const {
           {"poiseuille_flow_rate", "m^3/s",
            "Poiseuille flow rate pi G R^4 / (8 mu) with G the body force along the "
            "tube axis"},
-          {"relative_viscosity", "1", "apparent viscosity over fluid.mu: poiseuille_flow_rate / flow_rate"}};
+          {"relative_viscosity", "1", "apparent viscosity over fluid.mu: poiseuille_flow_rate / flow_rate"},
+          {"tube_hematocrit", "1", "the membranes' volume over the tube's fluid volume (0 without cells)"},
+          {"cell_free_layer", "m",
+           "R minus the mean over slices of the tube (one grid spacing long) holding membrane nodes of the largest "
+           "node distance from the axis in the slice (nan without cells)"}};
 }
 
 void TubeFlowRun::attach(SimulationInterface& sim) {
@@ -29,6 +36,9 @@ void TubeFlowRun::attach(SimulationInterface& sim) {
   Tube t;
   t.axis = s.axis;
   t.period = s.period;
+  t.centre = s.center;
+  t.radius = s.radius;
+  t.fluid_volume = prm.walls->fluid_volume(g);
   const double G = dot(prm.body_force, s.axis);
   t.poiseuille = std::numbers::pi * G * std::pow(s.radius, 4) / (8 * prm.mu);
   for (int d = 0; d < 3; ++d) {
@@ -59,6 +69,28 @@ void TubeFlowRun::add_run_values(const SimulationInterface& sim, std::vector<dou
   row.push_back(q);
   row.push_back(t.poiseuille);
   row.push_back(t.poiseuille / q);
+  // The cells: their volume, and per slice along the axis the outermost node.
+  const std::vector<std::vector<Vec3>> X = sim.positions();
+  double cells = 0;
+  const auto bins = static_cast<std::size_t>(std::max(1.0, std::round(t.period / h)));
+  std::vector<double> outer(bins, -1.0);
+  for (std::size_t m = 0; m < X.size(); ++m) {
+    cells += volume(sim.mesh(m), X[m]);
+    for (const Vec3& x : X[m]) {
+      Vec3 r = x - t.centre;
+      const double along = dot(r, t.axis);
+      const double radial = norm(r - along * t.axis);
+      const double w = along / t.period - std::floor(along / t.period);
+      const std::size_t b = std::min(bins - 1, static_cast<std::size_t>(w * static_cast<double>(bins)));
+      outer[b] = std::max(outer[b], radial);
+    }
+  }
+  double edge = 0;
+  int filled = 0;
+  for (const double o : outer)
+    if (o >= 0) edge += o, ++filled;
+  row.push_back(cells / t.fluid_volume);
+  row.push_back(filled > 0 ? t.radius - edge / filled : std::numeric_limits<double>::quiet_NaN());
 }
 
 }  // namespace immerse
