@@ -32,6 +32,13 @@ bool OutputFolder::is_run_file(const std::string& name) {
         all_digits(name.substr(0, name.size() - tail.size()), head.size()))
       return true;
   }
+  // mesh_wallN.stl, mesh_wallN.msh: the copies of the walls' surface files
+  for (const std::string tail : {".stl", ".msh"}) {
+    const std::string head = "mesh_wall";
+    if (name.size() > head.size() + tail.size() && name.rfind(head, 0) == 0 && name.ends_with(tail) &&
+        all_digits(name.substr(0, name.size() - tail.size()), head.size()))
+      return true;
+  }
   // fields_NNNNNN.h5 (at least six digits)
   const std::string head = "fields_", tail = ".h5";
   if (name.size() < head.size() + 6 + tail.size() || name.rfind(head, 0) != 0 ||

@@ -3,8 +3,9 @@
 // (flock on the folder itself, so no lock file is written), held until destruction: a second run into the same
 // folder is refused while the first one writes. The files a run writes (config.resolved.toml, diagnostics.csv,
 // stretch.csv, checkpoint.h5, unstable_state.h5, membranes.xdmf, fluid.xdmf, fields_NNNNNN.h5, and the copies of
-// mesh files mesh_membraneN.msh and mesh_membraneN_reference.msh) are "run files"; the temporaries of
-// interrupted atomic writes are "NAME.tmp.PID" of a run file. Other files in the folder are never touched.
+// mesh files mesh_membraneN.msh, mesh_membraneN_reference.msh, mesh_wallN.stl and mesh_wallN.msh) are "run files";
+// the temporaries of interrupted atomic writes are "NAME.tmp.PID" of a run file. Other files in the folder are never
+// touched.
 #include <filesystem>
 #include <string>
 #include <vector>

@@ -263,6 +263,20 @@ void check_membrane_keys(const io::Config& config) {
   }
 }
 
+// The keys the user gave to a wall they do not apply to (radius with shape = "surface", file with a tube, ...).
+void check_wall_keys(const io::Config& config) {
+  for (std::size_t i = 0; i < config.count("wall"); ++i) {
+    const io::Config& w = config.entry("wall", i);
+    const std::string p = "wall[" + std::to_string(i) + "].";
+    for (const auto& key : w.schema().keys())
+      if (w.given(key.key))
+        if (const std::string why = wall_key_not_applying(w, key.key); !why.empty())
+          throw InputError(p + key.key + ": " + why);
+    if (w.get<std::string>("shape") == "surface" && w.get<std::string>("file").empty())
+      throw InputError(p + "file: must be given (an STL or Gmsh file name) when shape = \"surface\"");
+  }
+}
+
 // Any kind: contact within one grid spacing unless contact.range is given.
 io::Config derive_contact(io::Config config) {
   if (!config.given("contact.range"))
@@ -300,6 +314,7 @@ io::Config derive(const io::Config& config) {
 
 io::Config apply_scenario(const io::Config& config) {
   check_membrane_keys(config);
+  check_wall_keys(config);
   io::Config derived = derive(config);
   leave_out_inapplicable(derived);
   // A step longer than the whole run is a mistake in one of the two (the run would silently take one short step).

@@ -10,14 +10,14 @@
 namespace immerse {
 
 void check_checkpoint_configuration(const io::Config& config, const io::Checkpoint& ck) {
-  // The names of mesh files may differ: a run folder's copy stands for its original (what the files hold is compared
-  // with the reference state by the restore).
+  // The names of mesh files (and of walls' surface files) may differ: a run folder's copy stands for its original (what
+  // the files hold is compared with the reference state by the restore).
   io::Config theirs = config.schema().parse_string(ck.get_string("config"), "checkpoint");
   leave_out_inapplicable(theirs);
   const auto may_change = [](const std::string& key) {
     return key == "time.end" || key == "scenario.kt_end" || key == "time.dt" || key == "scenario.k_dt" ||
            key == "time.dt_min" || key.starts_with("output.") || key.starts_with("solver.") || key == "mesh.file" ||
-           key == "mesh.reference_file";
+           key == "mesh.reference_file" || key == "file";
   };
   const auto differ = [&](const std::string& key, const std::string& was, const std::string& is) {
     throw InputError(key + " = " + is + ": the checkpoint " + ck.source() + " was written with " + key + " = " + was +

@@ -7,6 +7,7 @@
 #include "immerse/core/Error.hpp"
 #include "immerse/fluid/PoiseuilleFlow.hpp"
 #include "immerse/walls/WallGeometry.hpp"
+#include "immerse/walls/WallSurface.hpp"
 
 namespace immerse {
 
@@ -79,11 +80,23 @@ FluidParams run_fluid_params(const io::Config& c) {
     for (std::size_t i = 0; i < c.count("wall"); ++i) {
       const io::Config& w = c.entry("wall", i);
       WallShape s;
-      s.kind = w.get<std::string>("shape") == "sphere" ? WallShape::Kind::Sphere : WallShape::Kind::Tube;
+      const std::string shape = w.get<std::string>("shape");
+      s.name = "wall[" + std::to_string(i) + "]";
+      if (shape == "surface") {
+        // The file's coordinates times scale are the box's; its closed surface bounds a solid or the fluid.
+        const std::string file = w.get<std::string>("file");
+        require(!file.empty(), s.name + ".file", "an STL or Gmsh file name when shape = \"surface\"");
+        s.kind = WallShape::Kind::Surface;
+        s.surface =
+            std::make_shared<const WallSurface>(read_wall_surface(file, w.get<double>("scale"), s.name + ".file"));
+        s.fluid_inside = w.get<std::string>("inside") == "fluid";
+        shapes.push_back(s);
+        continue;
+      }
+      s.kind = shape == "sphere" ? WallShape::Kind::Sphere : WallShape::Kind::Tube;
       s.radius = w.get<double>("radius");
       s.center = w.get<Vec3>("center");
       s.axis = w.get<Vec3>("axis");
-      s.name = "wall[" + std::to_string(i) + "]";
       shapes.push_back(s);
     }
     p.walls = std::make_shared<const WallGeometry>(std::move(shapes), run_grid(c));

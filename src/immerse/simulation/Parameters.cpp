@@ -77,14 +77,24 @@ ConfigSchema membrane_schema() {
 
 ConfigSchema wall_schema() {
   ConfigSchema w;
-  w.add_string("shape", "tube", {"tube", "sphere"},
+  w.add_string("shape", "tube", {"tube", "sphere", "surface"},
                "tube: the fluid inside a circular cylinder (radius, center, axis), everything outside it wall; sphere: "
-               "a solid ball (radius, center) (src/immerse/walls/WallGeometry.hpp)");
+               "a solid ball (radius, center); surface: a closed triangulated surface read from a file (file, scale, "
+               "inside) (src/immerse/walls/WallGeometry.hpp, WallSurface.hpp)");
   w.add_double("radius", 1e-6, Range::positive(), "radius of the tube or sphere (m)");
   w.add_vec3("center", {0, 0, 0}, Range::any(), "a point on the tube's axis, or the sphere's centre (m); in the box");
   w.add_vec3("axis", {0, 0, 1}, Range::any(),
              "tube: direction of its axis, along (mx Lx, my Ly, mz Lz) with whole numbers m, so that the tube closes on "
              "itself across the periodic box ([0, 0, 1]: along z; [1, 0, 2] in a box with Lz = Lx: at 26.6 degrees)");
+  w.add_path("file",
+             "surface: STL (ASCII or binary) file of one or more, or Gmsh .msh file of one, closed, consistently "
+             "oriented, non-self-intersecting triangulated surfaces, in the box's coordinates times scale (periodic "
+             "images included); a relative name is taken from the configuration file's folder (given with --set: from the "
+             "current folder); the run folder keeps a copy");
+  w.add_double("scale", 1.0, Range::positive(), "surface: metres per length unit of the file (1e-6 for micrometres)");
+  w.add_string("inside", "solid", {"solid", "fluid"},
+               "surface: what the closed surface encloses: a solid obstacle (the fluid outside it), or the fluid (a "
+               "channel; everything outside it wall)");
   return w;
 }
 
@@ -235,12 +245,25 @@ std::string membrane_key_not_applying(const io::Config& m, const std::string& ke
   return "";
 }
 
+std::string wall_key_not_applying(const io::Config& w, const std::string& key) {
+  if (w.get<std::string>("shape") == "surface")
+    return key == "radius" || key == "center" || key == "axis"
+               ? "does not apply to shape = \"surface\" (the file gives the shape; use scale)"
+               : "";
+  return key == "file" || key == "scale" || key == "inside" ? "does not apply unless shape = \"surface\"" : "";
+}
+
 void leave_out_inapplicable(io::Config& config) {
   const bool shear = is_shear_kind(config.get<std::string>("scenario.kind"));
   for (std::size_t i = 0; i < config.count("membrane"); ++i) {
     const std::string p = "membrane[" + std::to_string(i) + "].";
     for (const auto& key : config.entry("membrane", i).schema().keys())
       if (!membrane_key_not_applying(config.entry("membrane", i), key.key, shear).empty()) config.leave_out(p + key.key);
+  }
+  for (std::size_t i = 0; i < config.count("wall"); ++i) {
+    const std::string p = "wall[" + std::to_string(i) + "].";
+    for (const auto& key : config.entry("wall", i).schema().keys())
+      if (!wall_key_not_applying(config.entry("wall", i), key.key).empty()) config.leave_out(p + key.key);
   }
 }
 

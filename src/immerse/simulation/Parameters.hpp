@@ -17,7 +17,11 @@ bool is_shear_kind(const std::string& kind);
 /// "" when it applies; `shear`: the run is a shear scenario (radius then sets its groups).
 std::string membrane_key_not_applying(const io::Config& m, const std::string& key, bool shear);
 
-/// Marks the keys of each [[membrane]] entry that do not apply to it as left out (io::Config::leave_out).
+/// Why key `key` of the [[wall]] entry `w` does not apply to it (e.g. radius with shape = "surface"), or "" when it
+/// applies.
+std::string wall_key_not_applying(const io::Config& w, const std::string& key);
+
+/// Marks the keys of each [[membrane]] and [[wall]] entry that do not apply to it as left out (io::Config::leave_out).
 void leave_out_inapplicable(io::Config& config);
 
 }  // namespace immerse

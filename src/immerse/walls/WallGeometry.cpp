@@ -46,6 +46,16 @@ WallGeometry::WallGeometry(std::vector<WallShape> shapes, const Grid& grid)
                        " = \"wall\": [[wall]] needs a box periodic along every "
                        "axis (the [[wall]] shapes are the walls)");
   for (WallShape& s : shapes_) {
+    if (s.kind == WallShape::Kind::Surface) {
+      if (!s.surface) throw InputError(s.name + ".file: no surface given");
+      const Vec3 lo = s.surface->lower(), hi = s.surface->upper();
+      for (int a = 0; a < 3; ++a)
+        if (hi[a] < origin_[a] || lo[a] > origin_[a] + length_[a])
+          throw InputError(s.name + ": the surface (bounding box " + vec_text(lo) + " to " + vec_text(hi) +
+                           ") lies outside the box " + vec_text(origin_) + " to " + vec_text(origin_ + length_) +
+                           " (is the file in another unit? scale converts it to metres)");
+      continue;
+    }
     if (!(s.radius > 0) || !std::isfinite(s.radius))
       throw InputError(s.name + ".radius = " + num_text(s.radius) + ": must be positive");
     if (!isfinite(s.center)) throw InputError(s.name + ".center = " + vec_text(s.center) + ": must be finite");
@@ -100,6 +110,7 @@ WallGeometry::WallGeometry(std::vector<WallShape> shapes, const Grid& grid)
 }
 
 double WallGeometry::shape_distance(const WallShape& s, const Vec3& x, Vec3& grad) const {
+  if (s.kind == WallShape::Kind::Surface) return surface_distance(s, x, grad);
   Vec3 r = x - s.center;
   for (int a = 0; a < 3; ++a)
     if (periodic_[a]) r[a] -= length_[a] * std::floor(r[a] / length_[a] + 0.5);
@@ -124,6 +135,43 @@ double WallGeometry::shape_distance(const WallShape& s, const Vec3& x, Vec3& gra
       }
     }
   });
+  return best;
+}
+
+double WallGeometry::surface_distance(const WallShape& s, const Vec3& x, Vec3& grad) const {
+  // The point shifted into the period about the surface's box centre, then by the 27 nearest lattice vectors; an image
+  // whose bounding box is farther than the least signed distance so far cannot lower it.
+  const WallSurface& S = *s.surface;
+  const Vec3 lo = S.lower(), hi = S.upper(), mid = 0.5 * (lo + hi);
+  Vec3 r = x - mid;
+  for (int a = 0; a < 3; ++a)
+    if (periodic_[a]) r[a] -= length_[a] * std::floor(r[a] / length_[a] + 0.5);
+  std::array<std::pair<double, Vec3>, 27> images;
+  int count = 0;
+  for_each_image(periodic_, length_, 1, [&](const Vec3& v) {
+    const Vec3 q = mid + r + v;
+    double b2 = 0;
+    for (int a = 0; a < 3; ++a) {
+      const double e = std::max({lo[a] - q[a], 0.0, q[a] - hi[a]});
+      b2 += e * e;
+    }
+    images[count++] = {std::sqrt(b2), q};
+  });
+  std::sort(images.begin(), images.begin() + count, [](const auto& a, const auto& b) { return a.first < b.first; });
+  double best = std::numeric_limits<double>::infinity();
+  Vec3 g;
+  for (int i = 0; i < count; ++i) {
+    if (images[i].first > 0 && images[i].first >= best) break;
+    const double d = S.signed_distance(images[i].second, g);
+    if (d < best) {
+      best = d;
+      grad = g;
+    }
+  }
+  if (s.fluid_inside) {
+    grad = -grad;
+    return -best;
+  }
   return best;
 }
 

@@ -6,33 +6,42 @@
 //   tube    the fluid inside a circular cylinder of radius R about the line     φ = R − |(x − c) − ((x − c)·t) t|
 //           through c along the unit vector t (everything outside is wall)
 //   sphere  a solid ball of radius R at c                                        φ = |x − c| − R
+//   surface a closed triangulated surface S (WallSurface, its signed distance    φ = d_S(x) (a solid obstacle) or
+//           d_S > 0 outside), bounding a solid or, fluid_inside, the fluid       φ = −d_S(x) (fluid inside)
 // The wall is the union of the shapes' solids, so φ = min over the shapes (exact wherever one shape is nearest, and its
 // sign always right). A tube must close on itself across the box: t along a whole-number combination of the periodic
 // box's edge vectors, with the tube clear of its own periodic images. Verified by the tests WallGeometry.* (distances,
-// normals, images, bad input) and, through the no-slip condition, GhostCellWalls.* and TubeFlow.*.
+// normals, images, bad input) and, through the no-slip condition, GhostCellWalls.* and TubeFlow.*. The images of a
+// surface are those of the 27 lattice shifts nearest to it, united as the tube's and the sphere's are (d_S = min over
+// the images): verified by the tests WallSurface.*.
 #include <array>
+#include <memory>
 #include <string>
 #include <vector>
 
 #include "immerse/core/Vec3.hpp"
 #include "immerse/grid/Grid.hpp"
+#include "immerse/walls/WallSurface.hpp"
 
 namespace immerse {
 
 struct WallShape {
-  enum class Kind { Tube, Sphere };
+  enum class Kind { Tube, Sphere, Surface };
   Kind kind = Kind::Tube;
   Vec3 center{};
   Vec3 axis{0, 0, 1};  ///< tube: its direction (normalized by WallGeometry)
   double radius = 0;
   double period = 0;   ///< tube: the length of its axis in one period of the box (set by WallGeometry)
   std::string name;    ///< "wall[i]", for messages
+  std::shared_ptr<const WallSurface> surface{};  ///< surface: the closed surface (radius, center, axis unused)
+  bool fluid_inside = false;                     ///< surface: the fluid inside it, all outside wall (else a solid)
 };
 
 class WallGeometry {
  public:
   /// Validates the shapes against the box (InputError naming the item): radius > 0, a tube's axis a lattice direction
-  /// of the box and the tube clear of its images, a sphere's centre in the box and the ball inside one period.
+  /// of the box and the tube clear of its images, a sphere's centre in the box and the ball inside one period, a
+  /// surface's bounding box meeting the box.
   WallGeometry(std::vector<WallShape> shapes, const Grid& grid);
 
   /// φ(x): the signed distance to the nearest wall, positive in the fluid.
@@ -48,6 +57,8 @@ class WallGeometry {
  private:
   /// φ of one shape at x (nearest periodic image) and its gradient.
   double shape_distance(const WallShape& s, const Vec3& x, Vec3& grad) const;
+  /// The same for a surface: the least signed distance to its images, negated if the fluid is inside.
+  double surface_distance(const WallShape& s, const Vec3& x, Vec3& grad) const;
 
   std::vector<WallShape> shapes_;
   Vec3 origin_, length_;
