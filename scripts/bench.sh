@@ -21,13 +21,13 @@ fi
 out=build/release/bench/results
 mkdir -p "$out"
 rm -f "$out"/*.json "$out"/*.txt
-if ! { cmake --preset release && cmake --build --preset release -j 2 --target bench_fluid bench_coupling bench_membrane \
+if ! { cmake --preset release && cmake --build --preset release -j 2 --target bench_fluid bench_coupling bench_membrane bench_walls \
          bench_oscillating bench_channel; } >"$out/build.log" 2>&1; then
   cat "$out/build.log" >&2
   exit 1
 fi
 echo "machine: $(nproc) cores, load average $(cut -d' ' -f1-3 /proc/loadavg) at start" | tee "$out/machine.txt"
-for b in bench_fluid bench_coupling bench_membrane; do
+for b in bench_fluid bench_coupling bench_membrane bench_walls; do
   echo "running $b ..." >&2
   args=(--benchmark_format=console --benchmark_out="$out/$b.json" --benchmark_out_format=json)
   [[ -n "$filter" ]] && args+=(--benchmark_filter="$filter")
