@@ -38,6 +38,10 @@ TEST(TubeFlow, ScenarioReachesPoiseuilleFlowRate) {
   EXPECT_NEAR(diss / body, 1.0, 1e-6);
   const auto& before = rows[rows.size() - 2];
   EXPECT_NEAR(std::stod(before[column(head, "flow_rate")]) / q, 1.0, 1e-9);
+  // The wall for ParaView: the tube's cylinder over one period, 51 points around (2πR/h) by 5 rings.
+  const std::string walls = read_text(dir / "out" / "walls.xdmf");
+  EXPECT_NE(walls.find("<Topology TopologyType=\"Triangle\" NumberOfElements=\"408\">"), std::string::npos);
+  EXPECT_NE(walls.find("<Attribute Name=\"wall\""), std::string::npos);
 }
 
 // fluid.initial = "poiseuille" in a tube: the steady flow of the cut-cell step from step 0 (the flow rate of the run
@@ -54,6 +58,23 @@ TEST(TubeFlow, PoiseuilleInitialFlowIsTheSteadyState) {
   const std::size_t q = column(rows[0], "flow_rate");
   for (std::size_t i = 1; i < rows.size(); ++i)
     EXPECT_NEAR(std::stod(rows[i][q]) / 8.3854166666660729e-15, 1.0, 1e-11) << i;  // the run from rest at t = 0.12 ms
+}
+
+// fluid.flow_rate along the tube: every step ends at the flow rate through the tube, and the steady state is the one
+// the body force of tube_flow.toml reaches (the step is linear in the force), so the same apparent viscosity.
+TEST(TubeFlow, FlowRateIsHeldThroughTheTube) {
+  ScratchDir dir("tube_flow_rate");
+  const auto r = run_immerse(run_args(scenario_file("tube_flow.toml"), dir / "out",
+                                      {"fluid.body_force=[0,0,0]", "fluid.flow_rate=[0,0,8.385416666666e-15]",
+                                       "output.fields_every=0"}),
+                             dir / "log");
+  ASSERT_EQ(r.status, 0) << r.err;
+  const auto rows = read_csv(dir / "out" / "diagnostics.csv");
+  ASSERT_EQ(rows.size(), 32u);
+  const auto& head = rows[0];
+  for (std::size_t i = 2; i < rows.size(); ++i)
+    EXPECT_NEAR(std::stod(rows[i][column(head, "flow_rate")]) / 8.385416666666e-15, 1.0, 1e-12) << i;
+  EXPECT_NEAR(std::stod(rows.back()[column(head, "relative_viscosity")]), 0.9990654898, 1e-8);
 }
 
 TEST(TubeFlow, RestartContinuesBitwise) {
@@ -93,6 +114,32 @@ TEST_P(TubeFlowBadInput, ExitsWithStatus2AndOneLineBeforeWritingAnything) {
       << "\n[[membrane]]\nshape = \"sphere\"\nradius = 4e-7\nmesh.level = 1\n"
       << (b.name == "membrane_inside_wall" ? "center = [5e-7, 5e-7, 1e-6]\n" : "center = [5e-6, 1.6e-6, 1e-6]\n");
   }
+  if (b.name.rfind("surface_", 0) == 0) {
+    // The tube replaced by a closed-or-not surface of tetrahedra (µm), written here.
+    const auto facet = [](std::ostream& o, Vec3 p, Vec3 q, Vec3 c) {
+      o << "facet normal 0 0 0\nouter loop\n";
+      for (const Vec3& v : {p, q, c}) o << "vertex " << v.x << " " << v.y << " " << v.z << "\n";
+      o << "endloop\nendfacet\n";
+    };
+    const auto tetra = [&](std::ostream& o, Vec3 q, bool all) {
+      const Vec3 a = q, e = q + Vec3{2, 0, 0}, c = q + Vec3{0, 2, 0}, d = q + Vec3{0, 0, 1};
+      facet(o, a, c, e);
+      facet(o, a, e, d);
+      facet(o, a, d, c);
+      if (all) facet(o, e, c, d);
+    };
+    std::ofstream stl(dir / "wall.stl");
+    stl << "solid w\n";
+    tetra(stl, {4, 4, 0.5}, b.name != "surface_open");
+    if (b.name == "surface_self_intersecting") tetra(stl, {4.5, 4.5, 0.7}, true);
+    stl << "endsolid w\n";
+    stl.close();
+    std::string text = read_text(scenario_file("tube_flow.toml"));
+    text = text.substr(0, text.find("\n[[wall]]") + 1);
+    text.replace(text.find("kind = \"tube_flow\""), 18, "kind = \"custom\"");
+    file = dir / "surface.toml";
+    std::ofstream(file) << text << "[[wall]]\nshape = \"surface\"\nfile = \"wall.stl\"\nscale = 1e-6\n";
+  }
   const auto r = run_immerse(run_args(file, dir / "out", b.sets), dir / "log");
   EXPECT_EQ(r.status, 2) << r.err;
   EXPECT_NE(r.err.find(b.message), std::string::npos) << r.err;
@@ -119,9 +166,12 @@ INSTANTIATE_TEST_SUITE_P(Walls, TubeFlowBadInput,
                                                    {"wall[0].shape=\"sphere\"", "wall[0].radius=1e-6"},
                                                    "wall[0].shape: must be \"tube\" for scenario.kind = "
                                                    "\"tube_flow\""},
-                                           BadWall{"flow_rate_with_walls",
-                                                   {"fluid.flow_rate=[0,0,1e-15]"},
-                                                   "fluid.flow_rate: must be zero with [[wall]] shapes"},
+                                           BadWall{"flow_rate_across_the_tube",
+                                                   {"fluid.flow_rate=[1e-15,0,0]"},
+                                                   "fluid.flow_rate: must be zero unless every [[wall]] is a tube "
+                                                   "along the flow axis x (wall[0] is not"},
+                                           BadWall{"surface_open", {}, "/wall.stl: the surface is open: edge"},
+                                           BadWall{"surface_self_intersecting", {}, "intersect: the surface crosses itself"},
                                            BadWall{"membrane_inside_wall", {}, "membrane[0] starts inside a [[wall]]"},
                                            BadWall{"membrane_near_wall", {}, "membrane[0] comes within"}),
                          [](const ::testing::TestParamInfo<BadWall>& p) { return p.param.name; });

@@ -165,15 +165,21 @@ void NavierStokesSolver::advance(const FluidState& in, double dt, const Array3& 
 // along the flow axis adds ΔG w, w = (I − c ∇_h²)⁻¹ Δt/ρ (divergence-free, as it does not vary along the axis).
 void NavierStokesSolver::hold_flow_rate(double dt, FluidState& out) {
   const int a = params_.flow_axis;
-  const auto mean = [](const std::vector<double>& v) {
+  // The mean over the box, of the fluid's points only with walls (the flow through the tubes' cross-sections).
+  const auto mean = [&](const std::vector<double>& v) {
     double s = 0;
-    for (const double x : v) s += x;
+    for (std::size_t i = 0; i < v.size(); ++i)
+      if (!walls_ || walls_->fluid(a, i)) s += v[i];
     return s / static_cast<double>(v.size());
   };
   if (flow_response_dt_ != dt) {
     Array3& w = ustar_[a];  // free again after the projection
     std::fill(w.values().begin(), w.values().end(), dt / params_.rho);
-    solvers_[a]->solve(w, 1.0, -mu_implicit_ * dt / (2.0 * params_.rho));
+    const double beta = -mu_implicit_ * dt / (2.0 * params_.rho);
+    if (walls_)
+      walls_->solve(a, w, 1.0, beta, *solvers_[a]);  // tubes along a: w does not vary along a either
+    else
+      solvers_[a]->solve(w, 1.0, beta);
     flow_response_ = w;
     flow_response_mean_ = mean(w.values());
     flow_response_dt_ = dt;

@@ -38,7 +38,9 @@
 // (one fast solve per step size; D w = 0 since w does not vary along a periodic a, so the projection leaves it). After
 // (12) each step adds ΔG w with ΔG = (U* − ⟨u_a^{n+1}⟩)/⟨w⟩, ⟨·⟩ the mean over the box: the step that ends at the mean
 // velocity U* under the body force f_body + ΔG, exactly, whatever the membranes do (the constant flow rate of channel-
-// flow codes). ΔG goes into the new state (FluidState::flow_force) for the diagnostics and the energy budget.
+// flow codes). ΔG goes into the new state (FluidState::flow_force) for the diagnostics and the energy budget. With
+// [[wall]] tubes along the flow axis (the only walls allowed with it), w is the walls' solve of the same problem, and
+// ⟨·⟩ sums the fluid's points only: the flow rate is the tubes'.
 // Verified by the tests RbcChannel.FlowRateIsHeldWhileThePressureDropRises, RestartFlowRate.* and
 // ParallelRun.RedCellChannelAtAFlowRateEqualsTheOneProcessRun.
 //

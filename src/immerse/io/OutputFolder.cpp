@@ -23,7 +23,7 @@ bool all_digits(const std::string& s, std::size_t from) {
 bool OutputFolder::is_run_file(const std::string& name) {
   for (const char* n : {"config.resolved.toml", "diagnostics.csv", "diagnostics.columns.csv", "stretch.csv",
                         "stretch.columns.csv", "checkpoint.h5", "unstable_state.h5", "membranes.xdmf",
-                        "fluid.xdmf"})
+                        "fluid.xdmf", "walls.xdmf"})
     if (name == n) return true;
   // mesh_membraneN.msh, mesh_membraneN_reference.msh: the copies of the mesh files
   for (const std::string tail : {".msh", "_reference.msh"}) {

@@ -5,6 +5,7 @@
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
+#include <sstream>
 #include <stdexcept>
 
 #include "immerse/core/Error.hpp"
@@ -12,6 +13,7 @@
 #include "immerse/io/CellFields.hpp"
 #include "immerse/io/Hdf5.hpp"
 #include "immerse/io/TomlFormat.hpp"
+#include "immerse/walls/WallGeometry.hpp"
 
 namespace immerse::io {
 
@@ -209,6 +211,27 @@ std::filesystem::path XdmfWriter::write_frame(double time, std::span<const Surfa
 
   append_frame(mx, fx);
   return path;
+}
+
+std::string walls_xdmf(const WallGeometry& walls, double h) {
+  std::vector<Vec3> v;
+  std::vector<std::array<int, 3>> t;
+  std::vector<int> shape;
+  walls.triangulate(h, v, t, shape);
+  std::ostringstream x;
+  x.precision(9);
+  x << "<?xml version=\"1.0\" ?>\n<Xdmf Version=\"3.0\">\n  <Domain>\n    <Grid Name=\"walls\" GridType=\"Uniform\">\n"
+    << "      <Topology TopologyType=\"Triangle\" NumberOfElements=\"" << t.size() << "\">\n"
+    << "        <DataItem Dimensions=\"" << t.size() << " 3\" NumberType=\"Int\" Format=\"XML\">\n";
+  for (const auto& tri : t) x << "          " << tri[0] << " " << tri[1] << " " << tri[2] << "\n";
+  x << "        </DataItem>\n      </Topology>\n      <Geometry GeometryType=\"XYZ\">\n"
+    << "        <DataItem Dimensions=\"" << v.size() << " 3\" NumberType=\"Float\" Precision=\"8\" Format=\"XML\">\n";
+  for (const Vec3& p : v) x << "          " << p.x << " " << p.y << " " << p.z << "\n";
+  x << "        </DataItem>\n      </Geometry>\n      <Attribute Name=\"wall\" AttributeType=\"Scalar\" Center=\"Cell\">\n"
+    << "        <DataItem Dimensions=\"" << t.size() << "\" NumberType=\"Int\" Format=\"XML\">\n";
+  for (const int k : shape) x << "          " << k << "\n";
+  x << "        </DataItem>\n      </Attribute>\n    </Grid>\n  </Domain>\n</Xdmf>\n";
+  return x.str();
 }
 
 std::string XdmfWriter::fluid_fragment(const std::string& file, int frame, double time, const Grid& g) {

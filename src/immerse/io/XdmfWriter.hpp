@@ -27,6 +27,10 @@
 #include "immerse/grid/FaceField.hpp"
 #include "immerse/grid/Grid.hpp"
 
+namespace immerse {
+class WallGeometry;
+}
+
 namespace immerse::io {
 
 /// One membrane surface at one output time. Names are [A-Za-z0-9_.-]; every field has one value per node; all
@@ -45,6 +49,10 @@ struct FluidFrame {
   const FaceField& velocity;
   const Array3& pressure;
 };
+
+/// An XDMF file of the walls' surfaces (WallGeometry::triangulate at spacing h), the data inline: a Triangle grid
+/// with the cell attribute `wall`, the index of the [[wall]] entry of each triangle.
+std::string walls_xdmf(const WallGeometry& walls, double h);
 
 class XdmfWriter {
  public:

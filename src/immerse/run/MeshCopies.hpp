@@ -2,7 +2,8 @@
 // The mesh files of a run, to be copied into its folder, and the configuration naming the copies
 // (mesh_membraneN.msh, mesh_membraneN_reference.msh, N the first membrane using the file; mesh_wallN.stl or
 // mesh_wallN.msh for the surface of [[wall]] N), so that the folder runs again as it is. A file several membranes or
-// walls use is copied once.
+// walls use is copied once. With [[wall]] shapes also walls.xdmf, their surfaces triangulated for ParaView
+// (io::walls_xdmf).
 #include <string>
 #include <utility>
 #include <vector>

@@ -39,8 +39,7 @@ void TubeFlowRun::attach(SimulationInterface& sim) {
   t.centre = s.center;
   t.radius = s.radius;
   t.fluid_volume = prm.walls->fluid_volume(g);
-  const double G = dot(prm.body_force, s.axis);
-  t.poiseuille = std::numbers::pi * G * std::pow(s.radius, 4) / (8 * prm.mu);
+  t.poiseuille = std::numbers::pi * std::pow(s.radius, 4) / (8 * prm.mu);  // per unit body force
   for (int d = 0; d < 3; ++d) {
     const std::array<int, 3> n = g.face_shape(d);
     t.fluid[d].resize(static_cast<std::size_t>(n[0]) * n[1] * n[2]);
@@ -66,9 +65,10 @@ void TubeFlowRun::add_run_values(const SimulationInterface& sim, std::vector<dou
   }
   const double h = sim.grid().h();
   const double q = sum * h * h * h / t.period;
+  const double poiseuille = t.poiseuille * dot(sim.step_body_force(), t.axis);  // with what fluid.flow_rate added
   row.push_back(q);
-  row.push_back(t.poiseuille);
-  row.push_back(t.poiseuille / q);
+  row.push_back(poiseuille);
+  row.push_back(poiseuille / q);
   // The cells: their volume, and per slice along the axis the outermost node.
   const std::vector<std::vector<Vec3>> X = sim.positions();
   double cells = 0;

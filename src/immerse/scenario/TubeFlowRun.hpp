@@ -26,7 +26,7 @@ class TubeFlowRun : public ScenarioRun {
   struct Tube {
     std::array<std::vector<unsigned char>, 3> fluid;  ///< φ > 0 at each velocity point
     Vec3 axis, centre;
-    double period = 0, poiseuille = 0;  ///< |P| (m); π G R⁴ / 8μ (m^3/s)
+    double period = 0, poiseuille = 0;  ///< |P| (m); π R⁴ / 8μ (m^3/s per N/m^3 of body force)
     double radius = 0, fluid_volume = 0;  ///< R (m); the fluid's volume in the box (m^3)
   };
   std::optional<Tube> tube_;

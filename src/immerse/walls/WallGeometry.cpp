@@ -4,8 +4,10 @@
 #include <cmath>
 #include <cstdio>
 #include <limits>
+#include <numbers>
 
 #include "immerse/core/Error.hpp"
+#include "immerse/walls/WallSurface.hpp"
 
 namespace immerse {
 
@@ -193,6 +195,46 @@ Vec3 WallGeometry::normal(const Vec3& x) const {
     }
   }
   return n;
+}
+
+void WallGeometry::triangulate(double h, std::vector<Vec3>& vertices, std::vector<std::array<int, 3>>& triangles,
+                               std::vector<int>& shape_of) const {
+  for (std::size_t k = 0; k < shapes_.size(); ++k) {
+    const WallShape& s = shapes_[k];
+    const int base = static_cast<int>(vertices.size());
+    if (s.kind == WallShape::Kind::Surface) {
+      for (const Vec3& v : s.surface->vertices()) vertices.push_back(v);
+      for (const auto& t : s.surface->triangles()) triangles.push_back({base + t[0], base + t[1], base + t[2]});
+      shape_of.resize(triangles.size(), static_cast<int>(k));
+      continue;
+    }
+    // A grid of rings: (rows + 1) rings of `around` points.
+    const int around = std::max(12, static_cast<int>(std::ceil(2 * std::numbers::pi * s.radius / h)));
+    const bool tube = s.kind == WallShape::Kind::Tube;
+    const int rows = tube ? std::max(1, static_cast<int>(std::ceil(s.period / h))) : std::max(6, around / 2);
+    const Vec3 t = tube ? s.axis : Vec3{0, 0, 1};
+    const Vec3 e1 = normalized(std::abs(t.x) < 0.9 ? cross(t, Vec3{1, 0, 0}) : cross(t, Vec3{0, 1, 0}));
+    const Vec3 e2 = cross(t, e1);
+    for (int r = 0; r <= rows; ++r)
+      for (int j = 0; j < around; ++j) {
+        const double phi = 2 * std::numbers::pi * j / around;
+        if (tube) {
+          vertices.push_back(s.center + (s.period * (static_cast<double>(r) / rows - 0.5)) * t +
+                             s.radius * (std::cos(phi) * e1 + std::sin(phi) * e2));
+        } else {
+          const double theta = std::numbers::pi * r / rows;
+          vertices.push_back(s.center + s.radius * (std::sin(theta) * (std::cos(phi) * e1 + std::sin(phi) * e2) +
+                                                    std::cos(theta) * t));
+        }
+      }
+    for (int r = 0; r < rows; ++r)
+      for (int j = 0; j < around; ++j) {
+        const int a = base + r * around + j, b = base + r * around + (j + 1) % around;
+        triangles.push_back({a, b, a + around});
+        triangles.push_back({b, b + around, a + around});
+      }
+    shape_of.resize(triangles.size(), static_cast<int>(k));
+  }
 }
 
 double WallGeometry::fluid_volume(const Grid& grid) const {

@@ -51,6 +51,12 @@ class WallGeometry {
 
   const std::vector<WallShape>& shapes() const { return shapes_; }
 
+  /// The walls' surfaces as triangles for display, at about spacing h: a tube over one period of its axis centred at
+  /// its centre, a sphere by latitude and longitude, a surface as it is. `shape_of` gets the index of each
+  /// triangle's shape.
+  void triangulate(double h, std::vector<Vec3>& vertices, std::vector<std::array<int, 3>>& triangles,
+                   std::vector<int>& shape_of) const;
+
   /// The fluid's volume in the box of `grid` (m³): the points with φ > 0 of a lattice of spacing h/2.
   double fluid_volume(const Grid& grid) const;
 
