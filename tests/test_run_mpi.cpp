@@ -352,6 +352,9 @@ TEST(RunMpi, BadInputOnThreeProcessesIsOneLineAndWritesNothing) {
   expect_refused(run_mpi(3, args, dir / "dense"), dir / "dense", "time.scheme = \"bfgs\"");
   args = run_args(scenario_file("rbc_stretch.toml"), dir / "kind", {"time.scheme=rk2"});
   expect_refused(run_mpi(3, args, dir / "kind"), dir / "kind", "scenario.kind = \"rbc_stretch\"");
+  args = run_args(scenario_file("tube_flow.toml"), dir / "walls",
+                  {"domain.Lz=6e-6", "grid.nz=12", "wall[0].center=[5e-6,5e-6,3e-6]"});
+  expect_refused(run_mpi(3, args, dir / "walls"), dir / "walls", "[[wall]]: must be absent in a run on several");
 }
 
 TEST(RunMpi, CheckpointOfAnotherGridAndTheFolderOfAnotherRunAreRefusedOnThreeProcesses) {
@@ -523,8 +526,9 @@ TEST(RunMpi, StopSignalToOneProcessStopsAllAfterTheSameStepWithACheckpoint) {
   EXPECT_EQ(r.status, 4) << r.err;
   EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
   EXPECT_EQ(r.err.rfind("immerse: interrupted by signal 15 at step ", 0), 0u) << r.err;
+  // Not before the last row seen (step 2): the signal may arrive before step 3 starts, and the run then stops there.
   const io::Checkpoint ck = io::Checkpoint::read(dir / "run" / "checkpoint.h5");
-  EXPECT_GE(ck.get_int("step"), 3);
+  EXPECT_GE(ck.get_int("step"), 2);
   EXPECT_LT(ck.get_int("step"), 500);
   EXPECT_NE(r.err.find("at step " + std::to_string(ck.get_int("step")) + ","), std::string::npos) << r.err;
 }

@@ -2,8 +2,10 @@
 
 #include <algorithm>
 #include <cmath>
+#include <complex>
 #include <limits>
 #include <map>
+#include <numbers>
 #include <string>
 
 #include "immerse/core/Error.hpp"
@@ -14,6 +16,9 @@ extern "C" {
 void dgetrf_(const int* m, const int* n, double* a, const int* lda, int* ipiv, int* info);
 void dgetrs_(const char* trans, const int* n, const int* nrhs, const double* a, const int* lda, const int* ipiv,
              double* b, const int* ldb, int* info, std::size_t trans_length);
+void zgetrf_(const int* m, const int* n, std::complex<double>* a, const int* lda, int* ipiv, int* info);
+void zgetrs_(const char* trans, const int* n, const int* nrhs, const std::complex<double>* a, const int* lda,
+             const int* ipiv, std::complex<double>* b, const int* ldb, int* info, std::size_t trans_length);
 }
 
 namespace immerse {
@@ -49,16 +54,29 @@ GhostCellWalls::GhostCellWalls(const Grid& grid, const WallGeometry& walls)
   const LatticeIndex L{grid.n()};
   const double h = grid.h();
   const std::size_t count = static_cast<std::size_t>(grid.n(0)) * grid.n(1) * grid.n(2);
-  std::vector<double> phi(count);
+  // Walls invariant along an axis (tubes along it): the rows of one plane normal to it, repeated plane by plane.
+  for (int a = 0; a < 3 && axis_ < 0; ++a) {
+    bool along = !walls.shapes().empty();
+    for (const WallShape& s : walls.shapes())
+      along = along && s.kind == WallShape::Kind::Tube && std::abs(s.axis[a]) == 1.0;
+    if (along) axis_ = a;
+  }
+  const auto plane_of = [&](std::size_t f) { return axis_ < 0 ? 0 : L.ijk(f)[axis_]; };
+  const auto shifted = [&](std::size_t f, int s) {
+    std::array<int, 3> q = L.ijk(f);
+    q[axis_] += s;
+    return L.flat(q[0], q[1], q[2]);
+  };
+  planes_ = axis_ < 0 ? 1 : grid.n(axis_);
   for (int d = 0; d < 3; ++d) {
     Component& c = comp_[d];
     c.fluid.assign(count, 0);
     for (int k = 0; k < grid.n(2); ++k)
       for (int j = 0; j < grid.n(1); ++j)
         for (int i = 0; i < grid.n(0); ++i) {
-          const std::size_t f = L.flat(i, j, k);
-          phi[f] = walls.distance(grid.face_position(d, i, j, k));
-          c.fluid[f] = phi[f] > 0;
+          std::array<int, 3> q{i, j, k};
+          if (axis_ >= 0) q[axis_] = 0;
+          c.fluid[L.flat(i, j, k)] = walls.distance(grid.face_position(d, q[0], q[1], q[2])) > 0;
         }
     c.row_start.push_back(0);
     for (std::size_t f = 0; f < count; ++f) {
@@ -66,6 +84,7 @@ GhostCellWalls::GhostCellWalls(const Grid& grid, const WallGeometry& walls)
         c.solid.push_back(f);
         continue;
       }
+      if (plane_of(f) != 0) continue;  // (invariant walls: repeated below)
       const auto [i, j, k] = L.ijk(f);
       const std::array<int, 3> q{i, j, k};
       const Vec3 x = grid.face_position(d, i, j, k);
@@ -106,6 +125,18 @@ GhostCellWalls::GhostCellWalls(const Grid& grid, const WallGeometry& walls)
       }
       c.row_start.push_back(c.col.size());
     }
+    // Invariant walls: plane s holds the rows of plane 0 shifted by s (cut point s·n_ring + i).
+    const std::size_t ring = c.cut.size();
+    for (int s = 1; s < planes_; ++s)
+      for (std::size_t i = 0; i < ring; ++i) {
+        c.cut.push_back(shifted(c.cut[i], s));
+        for (std::size_t e = c.row_start[i]; e < c.row_start[i + 1]; ++e) {
+          c.col.push_back(shifted(c.col[e], s));
+          c.val.push_back(c.val[e]);
+          c.diag.push_back(c.diag[e]);
+        }
+        c.row_start.push_back(c.col.size());
+      }
   }
 }
 
@@ -121,7 +152,11 @@ const GhostCellWalls::Factorization& GhostCellWalls::factorization(double alpha,
     }
   // Keep up to 8 step sizes (the trials of an adaptive or halved step, a cycle of steps), within 1 GB.
   std::size_t bytes = 0;
-  for (const Component& c : comp_) bytes += c.cut.size() * c.cut.size() * sizeof(double);
+  for (const Component& c : comp_) {
+    const std::size_t ring = c.cut.size() / planes_;
+    bytes += axis_ < 0 ? c.cut.size() * c.cut.size() * sizeof(double)
+                       : planes_ * ring * ring * sizeof(std::complex<double>);
+  }
   const std::size_t keep = std::clamp<std::size_t>(bytes > 0 ? (std::size_t{1} << 30) / bytes : 8, 1, 8);
   if (factors_.size() >= keep) {
     const auto oldest = std::min_element(factors_.begin(), factors_.end(),
@@ -141,35 +176,93 @@ const GhostCellWalls::Factorization& GhostCellWalls::factorization(double alpha,
   const LatticeIndex L{grid_.n()};
   for (int d = 0; d < 3; ++d) {
     const Component& c = comp_[d];
-    const int n = static_cast<int>(c.cut.size());
-    std::vector<double>& lu = fac.lu[d];
-    lu.assign(static_cast<std::size_t>(n) * n, 0.0);
-    fac.pivot[d].assign(n, 0);
-    if (n == 0) continue;
     std::vector<std::array<int, 3>> at(c.col.size());
     std::vector<double> a(c.col.size());
     for (std::size_t e = 0; e < c.col.size(); ++e) {
       at[e] = L.ijk(c.col[e]);
       a[e] = beta * c.val[e] + (c.diag[e] ? alpha : 0.0);
     }
+    // C_ij = Σ_e a_ie G(q_e − q_j) for the rows `rows` and the columns `cols` (column-major, rows fastest).
+    const auto fill = [&](std::size_t row0, int rows, std::size_t col0, int cols, double* out) {
 #pragma omp parallel for schedule(static)
-    for (int j = 0; j < n; ++j) {
-      const std::array<int, 3> qj = L.ijk(c.cut[j]);
-      double* const column = lu.data() + static_cast<std::size_t>(j) * n;
-      for (int i = 0; i < n; ++i) {
-        double sum = 0;
-        for (std::size_t e = c.row_start[i]; e < c.row_start[i + 1]; ++e)
-          sum += a[e] * green[L.flat(at[e][0] - qj[0], at[e][1] - qj[1], at[e][2] - qj[2])];
-        column[i] = sum;
+      for (int j = 0; j < cols; ++j) {
+        const std::array<int, 3> qj = L.ijk(c.cut[col0 + j]);
+        for (int i = 0; i < rows; ++i) {
+          double sum = 0;
+          for (std::size_t e = c.row_start[row0 + i]; e < c.row_start[row0 + i + 1]; ++e)
+            sum += a[e] * green[L.flat(at[e][0] - qj[0], at[e][1] - qj[1], at[e][2] - qj[2])];
+          out[static_cast<std::size_t>(j) * rows + i] = sum;
+        }
+      }
+    };
+    int info = 0;
+    if (axis_ < 0) {
+      const int n = static_cast<int>(c.cut.size());
+      std::vector<double>& lu = fac.lu[d];
+      lu.assign(static_cast<std::size_t>(n) * n, 0.0);
+      fac.pivot[d].assign(n, 0);
+      if (n == 0) continue;
+      fill(0, n, 0, n, lu.data());
+      dgetrf_(&n, &n, lu.data(), &n, fac.pivot[d].data(), &info);
+    } else {
+      // Block circulant: C_(s,i),(s',j) = c_ij(s − s'); the DFT along the axis turns it into the blocks
+      // Ĉ_m = Σ_δ c(δ) ω^(−mδ), ω = e^(2πi/P), one n_ring × n_ring system per wavenumber m.
+      const int n = static_cast<int>(c.cut.size() / planes_), P = planes_;
+      const std::size_t block = static_cast<std::size_t>(n) * n;
+      fac.blocks[d].assign(P * block, 0.0);
+      fac.pivot[d].assign(static_cast<std::size_t>(P) * n, 0);
+      if (n == 0) continue;
+      std::vector<double> cd(P * block);
+      for (int delta = 0; delta < P; ++delta) fill(static_cast<std::size_t>(delta) * n, n, 0, n, cd.data() + delta * block);
+      for (int m = 0; m < P; ++m) {
+        std::complex<double>* const b = fac.blocks[d].data() + m * block;
+        for (int delta = 0; delta < P; ++delta) {
+          const double angle = -2 * std::numbers::pi * static_cast<double>((m * delta) % P) / P;
+          const std::complex<double> w(std::cos(angle), std::sin(angle));
+          const double* const cdd = cd.data() + delta * block;
+          for (std::size_t q = 0; q < block; ++q) b[q] += cdd[q] * w;
+        }
+        zgetrf_(&n, &n, b, &n, fac.pivot[d].data() + static_cast<std::size_t>(m) * n, &info);
+        if (info != 0) break;
       }
     }
-    int info = 0;
-    dgetrf_(&n, &n, lu.data(), &n, fac.pivot[d].data(), &info);
     if (info != 0)
       throw SimulationError("GhostCellWalls: the capacitance matrix of velocity component " + std::to_string(d) +
-                            " is singular (LAPACK dgetrf info " + std::to_string(info) + ")");
+                            " is singular (LAPACK info " + std::to_string(info) + ")");
   }
   return fac;
+}
+
+void GhostCellWalls::block_solve(const Factorization& fac, int d) {
+  const int P = planes_, n = static_cast<int>(comp_[d].cut.size()) / planes_, one = 1;
+  const std::size_t block = static_cast<std::size_t>(n) * n;
+  std::vector<std::complex<double>> hat(static_cast<std::size_t>(P) * n, 0.0);
+  std::vector<std::complex<double>> w(P);  // ω^(−k), k = 0 … P − 1
+  for (int k = 0; k < P; ++k) {
+    const double angle = -2 * std::numbers::pi * k / P;
+    w[k] = {std::cos(angle), std::sin(angle)};
+  }
+  for (int m = 0; m < P; ++m) {
+    std::complex<double>* const h = hat.data() + static_cast<std::size_t>(m) * n;
+    for (int s = 0; s < P; ++s) {
+      const std::complex<double> ws = w[(m * s) % P];
+      const double* const r = rhs_.data() + static_cast<std::size_t>(s) * n;
+      for (int i = 0; i < n; ++i) h[i] += r[i] * ws;
+    }
+    int info = 0;
+    zgetrs_("N", &n, &one, fac.blocks[d].data() + m * block, &n, fac.pivot[d].data() + static_cast<std::size_t>(m) * n, h,
+            &n, &info, 1);
+  }
+  for (int s = 0; s < P; ++s) {
+    double* const y = rhs_.data() + static_cast<std::size_t>(s) * n;
+    for (int i = 0; i < n; ++i) y[i] = 0;
+    for (int m = 0; m < P; ++m) {
+      const std::complex<double> ws = std::conj(w[(m * s) % P]);
+      const std::complex<double>* const h = hat.data() + static_cast<std::size_t>(m) * n;
+      for (int i = 0; i < n; ++i) y[i] += (h[i] * ws).real();
+    }
+    for (int i = 0; i < n; ++i) y[i] /= P;
+  }
 }
 
 double GhostCellWalls::row_times(const Component& c, std::size_t i, const double* u) const {
@@ -193,9 +286,13 @@ void GhostCellWalls::solve(int d, Array3& x, double alpha, double beta, FftHelmh
     return;
   }
   for (int i = 0; i < n; ++i) rhs_[i] = row_times(c, i, u) - rhs_[i];  // Wᵀ v = a v − b
-  const int one = 1;
-  int info = 0;
-  dgetrs_("N", &n, &one, fac.lu[d].data(), &n, fac.pivot[d].data(), rhs_.data(), &n, &info, 1);
+  if (axis_ < 0) {
+    const int one = 1;
+    int info = 0;
+    dgetrs_("N", &n, &one, fac.lu[d].data(), &n, fac.pivot[d].data(), rhs_.data(), &n, &info, 1);
+  } else {
+    block_solve(fac, d);
+  }
   scratch_.values() = x.values();
   std::fill(x.values().begin(), x.values().end(), 0.0);
   for (int i = 0; i < n; ++i) u[c.cut[i]] = rhs_[i];

@@ -29,6 +29,7 @@
 // aligned and at 30° to the grid: the flow rate against π G R⁴ / 8μ and its order) and SphereArray.* (Stokes drag on a
 // simple cubic array of spheres against Zick & Homsy 1982).
 #include <array>
+#include <complex>
 #include <cstddef>
 #include <cstdint>
 #include <vector>
@@ -95,16 +96,21 @@ class GhostCellWalls {
     double alpha = 0, beta = 0;
     std::array<std::vector<double>, 3> lu;
     std::array<std::vector<int>, 3> pivot;
+    std::array<std::vector<std::complex<double>>, 3> blocks;  // walls invariant along axis_: Ĉ_m, LU-factored
     std::uint64_t used = 0;  // when it was last asked for
   };
   /// The factorization for (α, β): kept from an earlier call, or G by one fast solve in x (whose values are kept) and C
   /// built and factored, replacing the least recently used beyond 8 (or beyond 1 GB).
   const Factorization& factorization(double alpha, double beta, Array3& x, FftHelmholtzSolver& fast);
+  /// rhs_ ← C⁻¹ rhs_ for component d by the blocks of walls invariant along axis_.
+  void block_solve(const Factorization& fac, int d);
   /// Row i of the cut rows a (for alpha_, beta_) times u.
   double row_times(const Component& c, std::size_t i, const double* u) const;
 
   Grid grid_;
   std::array<Component, 3> comp_;
+  int axis_ = -1;   // the axis the walls are invariant along (tubes along it), or −1
+  int planes_ = 1;  // the planes normal to axis_ (1 without): cut point s·n_ring + i is point i of plane s
   std::vector<Factorization> factors_;
   std::uint64_t uses_ = 0;
   double alpha_, beta_;  // the last (α, β) solved with
