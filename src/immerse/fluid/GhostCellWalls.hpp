@@ -21,7 +21,9 @@
 // H is translation-invariant on the periodic box, so H⁻¹ E is the shifted lattice Green's function G = H⁻¹ e_0 and C_ij
 // = Σ_k a_ik G(q_k − q_j): one fast solve for G, then the n_c × n_c matrix C factored by LAPACK's LU, per (α, β), that
 // is per time step size (up to eight kept). Each solve is then two fast solves and a dense triangular solve: exact,
-// with no iteration, whatever the Reynolds number and the step.
+// with no iteration, whatever the Reynolds number and the step. Walls invariant along an axis (tubes along it, P
+// planes normal to it) make C block circulant, C_(s,i),(s′,j) = c_ij(s − s′): the DFT along the axis splits it into
+// P complex n_ring × n_ring blocks, one per wavenumber (block_solve), with P times less memory and work.
 //
 // The pressure projection (11)–(12) stays periodic: after it the velocity at the wall differs from zero by (Δt/ρ) G φ,
 // which vanishes as the flow becomes steady (φ → 0 in the pressure-increment form), so steady flows meet the cut rows
