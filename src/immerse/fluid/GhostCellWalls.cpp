@@ -37,6 +37,13 @@ struct LatticeIndex {
     const std::size_t r = f / n[0];
     return {i, static_cast<int>(r % n[1]), static_cast<int>(r / n[1])};
   }
+  /// The periodic 7-point ∇_h² of u at point f.
+  double laplacian(const double* u, std::size_t f, double inv_h2) const {
+    const auto [x, y, z] = ijk(f);
+    return (u[flat(x - 1, y, z)] + u[flat(x + 1, y, z)] + u[flat(x, y - 1, z)] + u[flat(x, y + 1, z)] +
+            u[flat(x, y, z - 1)] + u[flat(x, y, z + 1)] - 6.0 * u[f]) *
+           inv_h2;
+  }
 };
 
 }  // namespace
@@ -311,12 +318,7 @@ void GhostCellWalls::add_explicit_correction(int d, const Array3& un, double c, 
   for (std::size_t i = 0; i < comp.cut.size(); ++i) {
     double cut = 0;
     for (std::size_t e = comp.row_start[i]; e < comp.row_start[i + 1]; ++e) cut += comp.val[e] * u[comp.col[e]];
-    const auto [x, y, z] = L.ijk(comp.cut[i]);
-    const double periodic =
-        (u[L.flat(x - 1, y, z)] + u[L.flat(x + 1, y, z)] + u[L.flat(x, y - 1, z)] + u[L.flat(x, y + 1, z)] +
-         u[L.flat(x, y, z - 1)] + u[L.flat(x, y, z + 1)] - 6.0 * u[comp.cut[i]]) *
-        inv_h2;
-    rhs.data()[comp.cut[i]] += c * (cut - periodic);
+    rhs.data()[comp.cut[i]] += c * (cut - L.laplacian(u, comp.cut[i], inv_h2));
   }
 }
 
@@ -331,9 +333,7 @@ void GhostCellWalls::laplacian(int d, const Array3& u, Array3& out) const {
       o[f] = 0;
       continue;
     }
-    const auto [x, y, z] = L.ijk(f);
-    o[f] = (v[L.flat(x - 1, y, z)] + v[L.flat(x + 1, y, z)] + v[L.flat(x, y - 1, z)] + v[L.flat(x, y + 1, z)] +
-            v[L.flat(x, y, z - 1)] + v[L.flat(x, y, z + 1)] - 6.0 * v[f]) * inv_h2;
+    o[f] = L.laplacian(v, f, inv_h2);
   }
   for (std::size_t i = 0; i < c.cut.size(); ++i) {
     double sum = 0;

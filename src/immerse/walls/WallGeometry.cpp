@@ -13,12 +13,6 @@ namespace immerse {
 
 namespace {
 
-std::string vec_text(const Vec3& v) {
-  char buf[96];
-  std::snprintf(buf, sizeof buf, "[%g, %g, %g]", v.x, v.y, v.z);
-  return buf;
-}
-
 std::string num_text(double x) {
   char buf[32];
   std::snprintf(buf, sizeof buf, "%g", x);
@@ -53,18 +47,18 @@ WallGeometry::WallGeometry(std::vector<WallShape> shapes, const Grid& grid)
       const Vec3 lo = s.surface->lower(), hi = s.surface->upper();
       for (int a = 0; a < 3; ++a)
         if (hi[a] < origin_[a] || lo[a] > origin_[a] + length_[a])
-          throw InputError(s.name + ": the surface (bounding box " + vec_text(lo) + " to " + vec_text(hi) +
-                           ") lies outside the box " + vec_text(origin_) + " to " + vec_text(origin_ + length_) +
+          throw InputError(s.name + ": the surface (bounding box " + point_text(lo) + " to " + point_text(hi) +
+                           ") lies outside the box " + point_text(origin_) + " to " + point_text(origin_ + length_) +
                            " (is the file in another unit? scale converts it to metres)");
       continue;
     }
     if (!(s.radius > 0) || !std::isfinite(s.radius))
       throw InputError(s.name + ".radius = " + num_text(s.radius) + ": must be positive");
-    if (!isfinite(s.center)) throw InputError(s.name + ".center = " + vec_text(s.center) + ": must be finite");
+    if (!isfinite(s.center)) throw InputError(s.name + ".center = " + point_text(s.center) + ": must be finite");
     if (s.kind == WallShape::Kind::Sphere) {
       for (int a = 0; a < 3; ++a) {
         if (s.center[a] < origin_[a] || s.center[a] > origin_[a] + length_[a])
-          throw InputError(s.name + ".center = " + vec_text(s.center) + ": must lie in the box");
+          throw InputError(s.name + ".center = " + point_text(s.center) + ": must lie in the box");
         if (periodic_[a] && 2 * s.radius >= length_[a])
           throw InputError(s.name + ".radius = " + num_text(s.radius) +
                            ": the sphere meets its periodic image (the "
@@ -74,12 +68,12 @@ WallGeometry::WallGeometry(std::vector<WallShape> shapes, const Grid& grid)
       continue;
     }
     if (!isfinite(s.axis) || norm(s.axis) == 0)
-      throw InputError(s.name + ".axis = " + vec_text(s.axis) + ": must be a non-zero direction");
+      throw InputError(s.name + ".axis = " + point_text(s.axis) + ": must be a non-zero direction");
     const Vec3 given = s.axis;
     s.axis = normalized(s.axis);
     for (int a = 0; a < 3; ++a)
       if (s.center[a] < origin_[a] || s.center[a] > origin_[a] + length_[a])
-        throw InputError(s.name + ".center = " + vec_text(s.center) + ": must lie in the box");
+        throw InputError(s.name + ".center = " + point_text(s.center) + ": must lie in the box");
     // The axis returns onto itself after the lattice vector m_a L_a e_a (whole m_a, zero on a wall axis).
     bool closes = false;
     int lead = 0;
@@ -95,7 +89,7 @@ WallGeometry::WallGeometry(std::vector<WallShape> shapes, const Grid& grid)
       if (closes) s.period = norm(v);
     }
     if (!closes)
-      throw InputError(s.name + ".axis = " + vec_text(given) +
+      throw InputError(s.name + ".axis = " + point_text(given) +
                        ": a tube must close on itself across the box (its axis "
                        "along (mx Lx, my Ly, mz Lz) with whole "
                        "numbers m up to 16)");

@@ -22,12 +22,6 @@ namespace immerse {
 
 namespace {
 
-std::string ws_point(const Vec3& v) {
-  char buf[96];
-  std::snprintf(buf, sizeof buf, "[%g, %g, %g]", v.x, v.y, v.z);
-  return buf;
-}
-
 // Where the closest point of a triangle lies: its interior, a vertex k (VertexK) or the edge from vertex k (EdgeK).
 enum class WsRegion { Face, Vertex0, Vertex1, Vertex2, Edge0, Edge1, Edge2 };
 
@@ -91,7 +85,7 @@ WallSurface::WallSurface(std::vector<Vec3> vertices, std::vector<std::array<int,
   if (triangles_.empty()) fail("holds no triangles: must be a closed surface");
   const int nv = static_cast<int>(vertices_.size());
   for (const Vec3& v : vertices_)
-    if (!isfinite(v)) fail("vertex " + ws_point(v) + " is not finite");
+    if (!isfinite(v)) fail("vertex " + point_text(v) + " is not finite");
   for (std::size_t t = 0; t < triangles_.size(); ++t)
     for (int i : triangles_[t])
       if (i < 0 || i >= nv) fail(tri_text(t) + " refers to vertex " + std::to_string(i) + " of " + std::to_string(nv));
@@ -101,7 +95,7 @@ WallSurface::WallSurface(std::vector<Vec3> vertices, std::vector<std::array<int,
     const Vec3 a = vertices_[tr[0]], b = vertices_[tr[1]], c = vertices_[tr[2]];
     const double longest = std::max({dot(b - a, b - a), dot(c - b, c - b), dot(a - c, a - c)});
     if (tr[0] == tr[1] || tr[1] == tr[2] || tr[2] == tr[0] || !(0.5 * norm(cross(b - a, c - a)) > 1e-12 * longest))
-      fail(tri_text(t) + " (corners " + ws_point(a) + ", " + ws_point(b) + ", " + ws_point(c) + ") has zero area");
+      fail(tri_text(t) + " (corners " + point_text(a) + ", " + point_text(b) + ", " + point_text(c) + ") has zero area");
   }
   // Every edge in exactly two triangles, run in opposite directions by them; the defect of the lowest triangle.
   struct Use {
@@ -116,7 +110,7 @@ WallSurface::WallSurface(std::vector<Vec3> vertices, std::vector<std::array<int,
   std::vector<std::pair<std::size_t, std::string>> defects;
   for (const auto& [k, uses] : edges) {
     const int a = static_cast<int>(k >> 32), b = static_cast<int>(k & 0xffffffffu);
-    const std::string edge = "edge " + ws_point(vertices_[a]) + " - " + ws_point(vertices_[b]);
+    const std::string edge = "edge " + point_text(vertices_[a]) + " - " + point_text(vertices_[b]);
     if (uses.size() == 1)
       defects.emplace_back(uses[0].triangle, "the surface is open: " + edge + " of " + tri_text(uses[0].triangle) +
                                                  " belongs to no other triangle (every edge must join two)");
@@ -442,6 +436,12 @@ WallSurface read_wall_surface(const std::filesystem::path& file, double scale, c
     triangles.push_back(t);
   }
   return WallSurface(std::move(vertices), std::move(triangles), label);
+}
+
+std::string point_text(const Vec3& v) {
+  char buf[96];
+  std::snprintf(buf, sizeof buf, "[%g, %g, %g]", v.x, v.y, v.z);
+  return buf;
 }
 
 }  // namespace immerse

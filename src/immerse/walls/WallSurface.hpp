@@ -65,4 +65,7 @@ class WallSurface {
 /// (metres per file unit) and builds the checked surface; InputError "<name> <file>: <defect>" otherwise.
 WallSurface read_wall_surface(const std::filesystem::path& file, double scale, const std::string& name);
 
+/// "[x, y, z]" with %g, for the walls' messages.
+std::string point_text(const Vec3& v);
+
 }  // namespace immerse
