@@ -9,6 +9,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -50,6 +51,13 @@ class ScratchDir {
  private:
   fs::path path_;
 };
+
+/// The index of column `name` in a CSV header row (a test failure, and the row's length, if it is not there).
+inline std::size_t column(const std::vector<std::string>& head, const std::string& name) {
+  const auto it = std::find(head.begin(), head.end(), name);
+  EXPECT_NE(it, head.end()) << name;
+  return static_cast<std::size_t>(it - head.begin());
+}
 
 inline std::string read_text(const fs::path& path) {
   std::ifstream in(path, std::ios::binary);

@@ -18,11 +18,6 @@ void FluidParams::validate(const Grid& grid) const {
   if (flow_axis >= 0)
     require(grid.periodic(flow_axis), std::string("fluid.flow_rate.") + axis_name(flow_axis),
             std::string("zero: a flow rate is held along a periodic axis, and ") + axis_name(flow_axis) + " has walls");
-  if (walls && flow_axis >= 0)
-    for (const WallShape& s : walls->shapes())
-      require(s.kind == WallShape::Kind::Tube && std::abs(s.axis[flow_axis]) == 1.0, "fluid.flow_rate",
-              std::string("zero unless every [[wall]] is a tube along the flow axis ") + axis_name(flow_axis) +
-                  " (" + s.name + " is not; drive the flow by fluid.body_force)");
   for (int a = 0; a < 3; ++a) {
     if (grid.periodic(a)) continue;
     for (int d = 0; d < 3; ++d) {

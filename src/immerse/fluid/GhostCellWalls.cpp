@@ -61,13 +61,10 @@ GhostCellWalls::GhostCellWalls(const Grid& grid, const WallGeometry& walls)
   const LatticeIndex L{grid.n()};
   const double h = grid.h();
   const std::size_t count = static_cast<std::size_t>(grid.n(0)) * grid.n(1) * grid.n(2);
-  // Walls invariant along an axis (tubes along it): the rows of one plane normal to it, repeated plane by plane.
-  for (int a = 0; a < 3 && axis_ < 0; ++a) {
-    bool along = !walls.shapes().empty();
-    for (const WallShape& s : walls.shapes())
-      along = along && s.kind == WallShape::Kind::Tube && std::abs(s.axis[a]) == 1.0;
-    if (along) axis_ = a;
-  }
+  // Walls invariant along an axis (tubes along it, boxes spanning it): the rows of one plane normal to it, repeated
+  // plane by plane.
+  for (int a = 0; a < 3 && axis_ < 0; ++a)
+    if (walls.invariant_along(a)) axis_ = a;
   const auto plane_of = [&](std::size_t f) { return axis_ < 0 ? 0 : L.ijk(f)[axis_]; };
   const auto shifted = [&](std::size_t f, int s) {
     std::array<int, 3> q = L.ijk(f);
@@ -385,6 +382,40 @@ FluidEnergy GhostCellWalls::energy(const FluidParams& params, const FaceField& u
     }
   }
   return e;
+}
+
+bool GhostCellWalls::open_along(int d) const {
+  // Breadth-first search over the fluid points, each labelled with its winding along d (how often the path to it
+  // crossed the box's end along d): two paths that reach one point with different windings close around the box.
+  const LatticeIndex L{grid_.n()};
+  const std::vector<unsigned char>& fluid = comp_[d].fluid;
+  constexpr int unseen = std::numeric_limits<int>::min();
+  std::vector<int> winding(fluid.size(), unseen);
+  std::vector<std::size_t> queue;
+  for (std::size_t start = 0; start < fluid.size(); ++start) {
+    if (!fluid[start] || winding[start] != unseen) continue;
+    winding[start] = 0;
+    queue.assign(1, start);
+    for (std::size_t head = 0; head < queue.size(); ++head) {
+      const std::size_t f = queue[head];
+      const std::array<int, 3> q = L.ijk(f);
+      for (int a = 0; a < 3; ++a)
+        for (const int step : {-1, 1}) {
+          std::array<int, 3> r = q;
+          r[a] += step;
+          const std::size_t g = L.flat(r[0], r[1], r[2]);
+          if (!fluid[g]) continue;
+          const int w = winding[f] + (a == d ? (r[a] < 0 ? -1 : r[a] >= L.n[a] ? 1 : 0) : 0);
+          if (winding[g] == unseen) {
+            winding[g] = w;
+            queue.push_back(g);
+          } else if (winding[g] != w) {
+            return true;
+          }
+        }
+    }
+  }
+  return false;
 }
 
 double GhostCellWalls::cut_residual(int d, const Array3& x, const Array3& b) const {

@@ -77,6 +77,10 @@ class GhostCellWalls {
   /// force's work exactly); the rigid walls do no work.
   FluidEnergy energy(const FluidParams& params, const FaceField& u) const;
 
+  /// Whether the fluid points of component d join across the periodic box along axis d (a path of neighbouring fluid
+  /// points that winds once around it): a flow along d can pass the walls.
+  bool open_along(int d) const;
+
   /// Whether point i (flat index) of component d is in the fluid (φ > 0).
   bool fluid(int d, std::size_t i) const { return comp_[d].fluid[i] != 0; }
   std::size_t cut_count(int d) const { return comp_[d].cut.size(); }

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstddef>
 #include <stdexcept>
+#include <string>
 
 #include "immerse/core/Error.hpp"
 #include "immerse/fluid/MacStencil_K.hpp"
@@ -48,6 +49,11 @@ NavierStokesSolver::NavierStokesSolver(const Grid& grid, const FluidParams& para
   for (int l = 0; l < 4; ++l)
     solvers_[l] = std::make_unique<FftHelmholtzSolver>(grid_, static_cast<Layout>(l), planning, l < 3 ? &ustar_[l] : &phi_);
   if (params_.walls) walls_ = std::make_unique<GhostCellWalls>(grid_, *params_.walls);
+  if (walls_ && params_.flow_axis >= 0 && !walls_->open_along(params_.flow_axis)) {
+    const std::string a = axis_name(params_.flow_axis);
+    throw InputError("fluid.flow_rate." + a + ": the [[wall]] shapes leave the fluid no path across the box along " +
+                     a + " (drive a flow along an axis the walls let it through)");
+  }
 }
 
 FluidState NavierStokesSolver::initial_state() const {
@@ -114,10 +120,8 @@ void NavierStokesSolver::advance(const FluidState& in, double dt, const Array3& 
   ensure_shape(out.p, grid_);
   ensure_shape(out.p_prev, grid_);
 
-  const MacStencilGrid& g = geom_;
   const double rho = params_.rho, mu = mu_implicit_;
   const double c = mu * dt / (2.0 * rho);  // (I − c ∇_h²) u* = rhs
-  const double dt_rho = dt / rho;
 
   for (int d = 0; d < 3; ++d) {
     rhs(d);
@@ -128,27 +132,7 @@ void NavierStokesSolver::advance(const FluidState& in, double dt, const Array3& 
     else
       solvers_[d]->solve(ustar_[d], 1.0, -c);
   }
-  apply_wall_values(ustar_);
-
-  // (11): ∇_h² φ = (ρ/Δt) D u*, Neumann walls.
-  const double rho_dt = rho / dt;
-  for_each_row(g, IndexBox{{0, 0, 0}, g.n}, [&](int j, int k, int i0, int i1) {
-    if (mac::row_wraps(g, j, k))
-      divergence_row<mac::WrappedRows>(g, ustar_, rho_dt, div_, phi_, j, k, i0, i1);
-    else
-      divergence_row<mac::Strided>(g, ustar_, rho_dt, div_, phi_, j, k, i0, i1);
-  });
-  solvers_[3]->solve(phi_, 0.0, 1.0);
-
-  // (12) and (13).
-  const double half_mu = 0.5 * mu;
-  for_each_row(g, IndexBox{{0, 0, 0}, g.n}, [&](int j, int k, int, int) {
-    if (mac::row_wraps(g, j, k))
-      project_and_update_row<mac::WrappedRows>(g, ustar_, phi_, div_, p, in.p, out, j, k, dt_rho, half_mu);
-    else
-      project_and_update_row<mac::Strided>(g, ustar_, phi_, div_, p, in.p, out, j, k, dt_rho, half_mu);
-  });
-  apply_wall_values(out.u);
+  project(dt, p, in.p, out);
   if (params_.flow_axis >= 0) hold_flow_rate(dt, out);
   if (params_.variable_viscosity) {
     ensure_shape(out.u_prev, grid_);
@@ -161,33 +145,77 @@ void NavierStokesSolver::advance(const FluidState& in, double dt, const Array3& 
   out.time = in.time + dt;
 }
 
+void NavierStokesSolver::project(double dt, const Array3& p0, const Array3& pn, FluidState& out) {
+  const MacStencilGrid& g = geom_;
+  apply_wall_values(ustar_);
+  // (11): ∇_h² φ = (ρ/Δt) D u*, Neumann walls.
+  const double rho_dt = params_.rho / dt, dt_rho = dt / params_.rho;
+  for_each_row(g, IndexBox{{0, 0, 0}, g.n}, [&](int j, int k, int i0, int i1) {
+    if (mac::row_wraps(g, j, k))
+      divergence_row<mac::WrappedRows>(g, ustar_, rho_dt, div_, phi_, j, k, i0, i1);
+    else
+      divergence_row<mac::Strided>(g, ustar_, rho_dt, div_, phi_, j, k, i0, i1);
+  });
+  solvers_[3]->solve(phi_, 0.0, 1.0);
+
+  // (12) and (13).
+  const double half_mu = 0.5 * mu_implicit_;
+  for_each_row(g, IndexBox{{0, 0, 0}, g.n}, [&](int j, int k, int, int) {
+    if (mac::row_wraps(g, j, k))
+      project_and_update_row<mac::WrappedRows>(g, ustar_, phi_, div_, p0, pn, out, j, k, dt_rho, half_mu);
+    else
+      project_and_update_row<mac::Strided>(g, ustar_, phi_, div_, p0, pn, out, j, k, dt_rho, half_mu);
+  });
+  apply_wall_values(out.u);
+}
+
 // The step is linear in the body force (the advection term and the pressure are of the state before it): adding ΔG
 // along the flow axis adds ΔG w, w = (I − c ∇_h²)⁻¹ Δt/ρ (divergence-free, as it does not vary along the axis).
 void NavierStokesSolver::hold_flow_rate(double dt, FluidState& out) {
   const int a = params_.flow_axis;
-  // The mean over the box, of the fluid's points only with walls (the flow through the tubes' cross-sections).
+  // The mean over the box, of the fluid's points only with walls (the flow through the walls' cross-sections).
   const auto mean = [&](const std::vector<double>& v) {
     double s = 0;
     for (std::size_t i = 0; i < v.size(); ++i)
       if (!walls_ || walls_->fluid(a, i)) s += v[i];
     return s / static_cast<double>(v.size());
   };
+  // Walls that vary along a (a constriction): w has a divergence, and the response is w projected as u* is.
+  const bool projected = walls_ && !params_.walls->invariant_along(a);
   if (flow_response_dt_ != dt) {
-    Array3& w = ustar_[a];  // free again after the projection
-    std::fill(w.values().begin(), w.values().end(), dt / params_.rho);
+    ensure_shape(flow_response_.u, grid_);
+    for (int d = 0; d < 3; ++d) {
+      std::fill(ustar_[d].values().begin(), ustar_[d].values().end(), d == a ? dt / params_.rho : 0.0);
+    }
     const double beta = -mu_implicit_ * dt / (2.0 * params_.rho);
     if (walls_)
-      walls_->solve(a, w, 1.0, beta, *solvers_[a]);  // tubes along a: w does not vary along a either
+      walls_->solve(a, ustar_[a], 1.0, beta, *solvers_[a]);
     else
-      solvers_[a]->solve(w, 1.0, beta);
-    flow_response_ = w;
-    flow_response_mean_ = mean(w.values());
+      solvers_[a]->solve(ustar_[a], 1.0, beta);
+    ensure_shape(flow_response_.p, grid_);
+    ensure_shape(flow_response_.p_prev, grid_);
+    if (projected) {
+      Array3 zero(grid_.n(0), grid_.n(1), grid_.n(2));
+      project(dt, zero, zero, flow_response_);
+    } else {
+      flow_response_.u[a] = ustar_[a];
+      std::fill(flow_response_.p.values().begin(), flow_response_.p.values().end(), 0.0);
+    }
+    flow_response_mean_ = mean(flow_response_.u[a].values());
     flow_response_dt_ = dt;
   }
-  std::vector<double>& u = out.u[a].values();
-  const double G = (params_.flow_mean_velocity - mean(u)) / flow_response_mean_;
-  const std::vector<double>& w = flow_response_.values();
-  for (std::size_t i = 0; i < u.size(); ++i) u[i] += G * w[i];
+  const double G = (params_.flow_mean_velocity - mean(out.u[a].values())) / flow_response_mean_;
+  for (int d = 0; d < 3; ++d) {
+    if (!projected && d != a) continue;
+    std::vector<double>& u = out.u[d].values();
+    const std::vector<double>& w = flow_response_.u[d].values();
+    for (std::size_t i = 0; i < u.size(); ++i) u[i] += G * w[i];
+  }
+  if (projected) {
+    std::vector<double>& p = out.p.values();
+    const std::vector<double>& q = flow_response_.p.values();
+    for (std::size_t i = 0; i < p.size(); ++i) p[i] += G * q[i];
+  }
   out.flow_force = G;
 }
 

@@ -39,8 +39,10 @@
 // (12) each step adds ΔG w with ΔG = (U* − ⟨u_a^{n+1}⟩)/⟨w⟩, ⟨·⟩ the mean over the box: the step that ends at the mean
 // velocity U* under the body force f_body + ΔG, exactly, whatever the membranes do (the constant flow rate of channel-
 // flow codes). ΔG goes into the new state (FluidState::flow_force) for the diagnostics and the energy budget. With
-// [[wall]] tubes along the flow axis (the only walls allowed with it), w is the walls' solve of the same problem, and
-// ⟨·⟩ sums the fluid's points only: the flow rate is the tubes'.
+// [[wall]] shapes, w is the walls' solve of the same problem and ⟨·⟩ sums the fluid's points only (for a divergence-
+// free field the mean of u_a over the box is the flow rate through any cross-section over the box's); walls that vary
+// along a (a constriction) give w a divergence, and the response is then w projected by (11)–(13), velocity (all
+// three components) and pressure, so that ΔG times it is exactly what the body force ΔG adds to the step.
 // Verified by the tests RbcChannel.FlowRateIsHeldWhileThePressureDropRises, RestartFlowRate.* and
 // ParallelRun.RedCellChannelAtAFlowRateEqualsTheOneProcessRun.
 //
@@ -165,6 +167,9 @@ class NavierStokesSolver {
   template <class Rhs>
   void advance(const FluidState& in, double dt, const Array3& p, FluidState& out, Rhs&& rhs);
 
+  /// (11)–(13) on u* (ustar_): the pressure increment, u^{n+1} into out.u and p^{n+1/2} = p0 + φ − (μ/2) D u* into
+  /// out.p, pn into out.p_prev.
+  void project(double dt, const Array3& p0, const Array3& pn, FluidState& out);
   /// fluid.flow_rate ("Flow rate" above): adds ΔG w to the flow axis's velocity of `out`, w the step's response to a
   /// unit body force along it (cached for the step size), so that its mean is FluidParams::flow_mean_velocity;
   /// out.flow_force = ΔG.
@@ -179,7 +184,7 @@ class NavierStokesSolver {
 
   MacStencilGrid geom0_;        // homogeneous walls: the part of ∇_h² that the remainder of a variable viscosity takes
   double mu_implicit_;   // μ_p (μ without a variable viscosity)
-  Array3 flow_response_;           // w of hold_flow_rate, for steps of flow_response_dt_
+  FluidState flow_response_;       // w (u) and its pressure (p) of hold_flow_rate, for steps of flow_response_dt_
   double flow_response_dt_ = 0;
   double flow_response_mean_ = 0;  // its mean over the box
   PreparedStep own_;     // the one-pass step's preparation, with a variable viscosity

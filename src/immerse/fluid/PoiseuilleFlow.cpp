@@ -29,10 +29,12 @@ void set_tube_poiseuille_flow(const Grid& grid, const FluidParams& params, FaceF
   std::array<double, 3> length{};
   n[a] = 2;
   for (int d = 0; d < 3; ++d) length[d] = n[d] * grid.h();
+  if (!params.walls->invariant_along(a))
+    throw InputError(std::string("fluid.initial = \"poiseuille\": the [[wall]] shapes must not vary along ") +
+                     axis_name(a) + ", the body force (tubes along it, boxes spanning it)");
   for (WallShape& s : section_shapes) {
-    require(s.kind == WallShape::Kind::Tube && std::abs(s.axis[a]) == 1.0, s.name + ".axis",
-            std::string("along ") + axis_name(a) + ", the body force, for fluid.initial = \"poiseuille\" (tubes only)");
     s.center[a] = grid.origin()[a] + grid.h();
+    s.size[a] = std::max(s.size[a], length[a]);  // a box spanning the box spans the section
   }
   const Grid section(n, length, {grid.bc(0), grid.bc(1), grid.bc(2)}, grid.origin());
   GhostCellWalls walls(section, WallGeometry(section_shapes, section));

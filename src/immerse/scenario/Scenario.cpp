@@ -264,6 +264,20 @@ void check_membrane_keys(const io::Config& config) {
 }
 
 // The keys the user gave to a wall they do not apply to (radius with shape = "surface", file with a tube, ...).
+// The wall a scenario kind measures, before the keys of the entries (a key of another shape is then the lesser error).
+void check_kind_walls(const io::Config& config) {
+  const std::string kind = config.get<std::string>("scenario.kind");
+  const auto first_is = [&](const std::string& shape) {
+    return config.count("wall") > 0 && config.entry("wall", 0).get<std::string>("shape") == shape;
+  };
+  if (kind == "tube_flow")
+    require(first_is("tube"), "wall[0].shape",
+            "\"tube\" for scenario.kind = \"tube_flow\" (the tube whose flow rate it reports)");
+  if (kind == "capsule_constriction")
+    require(first_is("constriction"), "wall[0].shape",
+            "\"constriction\" for scenario.kind = \"capsule_constriction\" (the constriction it measures)");
+}
+
 void check_wall_keys(const io::Config& config) {
   for (std::size_t i = 0; i < config.count("wall"); ++i) {
     const io::Config& w = config.entry("wall", i);
@@ -302,9 +316,16 @@ io::Config check_suspension_shear(const io::Config& config) {
 io::Config derive(const io::Config& config) {
   const std::string kind = config.get<std::string>("scenario.kind");
   if (kind == "suspension_shear") return derive_contact(derive_centres(check_suspension_shear(config)));
-  if (kind == "tube_flow")
-    require(config.count("wall") > 0 && config.entry("wall", 0).get<std::string>("shape") == "tube", "wall[0].shape",
-            "\"tube\" for scenario.kind = \"tube_flow\" (the tube whose flow rate it reports)");
+  if (kind == "capsule_constriction") {
+    // (an axis that is not a coordinate axis is the wall's error, named by WallGeometry)
+    const Vec3 axis = config.entry("wall", 0).get<Vec3>("axis"), Q = config.get<Vec3>("fluid.flow_rate");
+    const int along = (axis.x != 0) + (axis.y != 0) + (axis.z != 0);
+    for (int a = 0; a < 3 && along == 1; ++a)
+      if ((axis[a] == 0) != (Q[a] == 0))
+        throw InputError("fluid.flow_rate = " + config.value_text("fluid.flow_rate") +
+                         ": scenario.kind = \"capsule_constriction\" holds a flow rate along the constriction's axis "
+                         "wall[0].axis = " + config.entry("wall", 0).value_text("axis"));
+  }
   if (kind == "rbc_stretch" || kind == "rbc_channel") return derive_contact(derive_centres(derive_cells(config, kind)));
   if (is_shear(kind)) return derive_contact(derive_centres(derive_shear(config, kind)));
   return derive_contact(derive_centres(config));
@@ -314,6 +335,7 @@ io::Config derive(const io::Config& config) {
 
 io::Config apply_scenario(const io::Config& config) {
   check_membrane_keys(config);
+  check_kind_walls(config);
   check_wall_keys(config);
   io::Config derived = derive(config);
   leave_out_inapplicable(derived);

@@ -4,6 +4,7 @@
 #include "immerse/scenario/StretchSweepRun.hpp"
 #include "immerse/scenario/SuspensionShearRun.hpp"
 #include "immerse/scenario/TubeFlowRun.hpp"
+#include "immerse/scenario/CapsuleConstrictionRun.hpp"
 
 namespace immerse {
 
@@ -13,6 +14,7 @@ std::unique_ptr<ScenarioRun> make_scenario_run(const io::Config& config) {
   if (kind == "rbc_channel") return std::make_unique<ChannelRun>();
   if (kind == "suspension_shear") return std::make_unique<SuspensionShearRun>(config);
   if (kind == "tube_flow") return std::make_unique<TubeFlowRun>();
+  if (kind == "capsule_constriction") return std::make_unique<CapsuleConstrictionRun>();
   return std::make_unique<ScenarioRun>();
 }
 

@@ -93,10 +93,16 @@ FluidParams run_fluid_params(const io::Config& c) {
         shapes.push_back(s);
         continue;
       }
-      s.kind = shape == "sphere" ? WallShape::Kind::Sphere : WallShape::Kind::Tube;
+      s.kind = shape == "sphere"         ? WallShape::Kind::Sphere
+               : shape == "box"          ? WallShape::Kind::Box
+               : shape == "constriction" ? WallShape::Kind::Constriction
+                                         : WallShape::Kind::Tube;
       s.radius = w.get<double>("radius");
       s.center = w.get<Vec3>("center");
       s.axis = w.get<Vec3>("axis");
+      s.size = w.get<Vec3>("size");
+      s.throat = w.get<Vec3>("throat");
+      s.fluid_inside = shape == "box" && w.get<std::string>("inside") == "fluid";
       shapes.push_back(s);
     }
     p.walls = std::make_shared<const WallGeometry>(std::move(shapes), run_grid(c));

@@ -1,5 +1,9 @@
 #include "immerse/simulation/Parameters.hpp"
 
+#include <map>
+#include <set>
+#include <string>
+
 #include "immerse/timestep/MembraneIntegrator.hpp"
 
 namespace immerse {
@@ -77,15 +81,27 @@ ConfigSchema membrane_schema() {
 
 ConfigSchema wall_schema() {
   ConfigSchema w;
-  w.add_string("shape", "tube", {"tube", "sphere", "surface"},
+  w.add_string("shape", "tube", {"tube", "sphere", "box", "constriction", "surface"},
                "tube: the fluid inside a circular cylinder (radius, center, axis), everything outside it wall; sphere: "
-               "a solid ball (radius, center); surface: a closed triangulated surface read from a file (file, scale, "
-               "inside) (src/immerse/walls/WallGeometry.hpp, WallSurface.hpp)");
+               "a solid ball (radius, center); box: an axis-aligned box (center, size, inside), a solid block or a "
+               "rectangular channel; constriction: a rectangular channel along a coordinate axis narrowed over a "
+               "length (center, axis, size, throat); surface: a closed triangulated surface read from a file (file, "
+               "scale, inside) (src/immerse/walls/WallGeometry.hpp, WallSurface.hpp)");
   w.add_double("radius", 1e-6, Range::positive(), "radius of the tube or sphere (m)");
-  w.add_vec3("center", {0, 0, 0}, Range::any(), "a point on the tube's axis, or the sphere's centre (m); in the box");
+  w.add_vec3("center", {0, 0, 0}, Range::any(),
+             "a point on the tube's axis, the sphere's or box's centre, or the centre of the constriction's throat (m); "
+             "in the box");
   w.add_vec3("axis", {0, 0, 1}, Range::any(),
              "tube: direction of its axis, along (mx Lx, my Ly, mz Lz) with whole numbers m, so that the tube closes on "
-             "itself across the periodic box ([0, 0, 1]: along z; [1, 0, 2] in a box with Lz = Lx: at 26.6 degrees)");
+             "itself across the periodic box ([0, 0, 1]: along z; [1, 0, 2] in a box with Lz = Lx: at 26.6 degrees); "
+             "constriction: the channel's axis, [1, 0, 0], [0, 1, 0] or [0, 0, 1]");
+  w.add_vec3("size", {1e-6, 1e-6, 1e-6}, Range::positive(),
+             "box: its edge lengths (m), an edge at least the box's length making it span that periodic axis (with "
+             "inside = \"fluid\": a rectangular channel along it); constriction: the channel's widths across its axis "
+             "(m; the component along the axis is not used: the channel runs across the periodic box)");
+  w.add_vec3("throat", {5e-7, 5e-7, 5e-7}, Range::positive(),
+             "constriction: the throat's widths across the axis, at most the channel's and below them along at least "
+             "one axis, and its length along the axis, below the box's (m)");
   w.add_path("file",
              "surface: STL (ASCII or binary) file of one or more, or Gmsh .msh file of one, closed, consistently "
              "oriented, non-self-intersecting triangulated surfaces, in the box's coordinates times scale (periodic "
@@ -93,8 +109,8 @@ ConfigSchema wall_schema() {
              "current folder); the run folder keeps a copy");
   w.add_double("scale", 1.0, Range::positive(), "surface: metres per length unit of the file (1e-6 for micrometres)");
   w.add_string("inside", "solid", {"solid", "fluid"},
-               "surface: what the closed surface encloses: a solid obstacle (the fluid outside it), or the fluid (a "
-               "channel; everything outside it wall)");
+               "box, surface: what the box or the closed surface encloses: a solid obstacle (the fluid outside it), or "
+               "the fluid (a channel; everything outside it wall)");
   return w;
 }
 
@@ -104,7 +120,7 @@ ConfigSchema run_schema() {
   ConfigSchema s;
   s.add_string("scenario.kind", "custom",
                {"custom", "none", "oscillating_membrane", "capsule_shear", "oblate_shear", "bending_shear",
-                "rbc_stretch", "rbc_channel", "suspension_shear", "tube_flow"},
+                "rbc_stretch", "rbc_channel", "suspension_shear", "tube_flow", "capsule_constriction"},
                "custom: your own experiment, every value as given (\"none\" is its former name); otherwise an experiment "
                "of the paper whose nondimensional groups below set the dimensional values the file leaves unset "
                "(see scenarios/README.md)");
@@ -246,11 +262,19 @@ std::string membrane_key_not_applying(const io::Config& m, const std::string& ke
 }
 
 std::string wall_key_not_applying(const io::Config& w, const std::string& key) {
-  if (w.get<std::string>("shape") == "surface")
-    return key == "radius" || key == "center" || key == "axis"
-               ? "does not apply to shape = \"surface\" (the file gives the shape; use scale)"
-               : "";
-  return key == "file" || key == "scale" || key == "inside" ? "does not apply unless shape = \"surface\"" : "";
+  const std::string shape = w.get<std::string>("shape");
+  if (key == "shape") return "";
+  static const std::map<std::string, std::set<std::string>> keys{
+      {"tube", {"radius", "center", "axis"}},
+      {"sphere", {"radius", "center"}},
+      {"box", {"center", "size", "inside"}},
+      {"constriction", {"center", "axis", "size", "throat"}},
+      {"surface", {"file", "scale", "inside"}}};
+  const auto& own = keys.at(shape);
+  if (own.contains(key)) return "";
+  std::string list;
+  for (const std::string& k : own) list += (list.empty() ? "" : ", ") + k;
+  return "does not apply to shape = \"" + shape + "\" (its keys: " + list + ")";
 }
 
 void leave_out_inapplicable(io::Config& config) {

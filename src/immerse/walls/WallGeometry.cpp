@@ -28,6 +28,103 @@ void for_each_image(const std::array<bool, 3>& periodic, const Vec3& length, int
       for (int mx = -rx; mx <= rx; ++mx) f(Vec3{mx * length.x, my * length.y, mz * length.z});
 }
 
+// b_s(r): the signed distance to the box |r_a| ≤ half_a over the axes it does not span, and its gradient.
+double box_distance(const Vec3& r, const Vec3& half, const std::array<bool, 3>& span, Vec3& grad) {
+  double out2 = 0, inner = -std::numeric_limits<double>::infinity();
+  int lead = -1;
+  Vec3 g{};
+  for (int a = 0; a < 3; ++a) {
+    if (span[a]) continue;
+    const double q = std::abs(r[a]) - half[a];
+    if (q > 0) {
+      out2 += q * q;
+      g[a] = r[a] >= 0 ? q : -q;
+    }
+    if (q > inner) {
+      inner = q;
+      lead = a;
+    }
+  }
+  if (out2 > 0) {
+    const double d = std::sqrt(out2);
+    grad = g / d;
+    return d;
+  }
+  grad = Vec3{};
+  if (lead >= 0) grad[lead] = r[lead] >= 0 ? 1.0 : -1.0;
+  return inner;
+}
+
+// The zero level set of f over the box [o, o + L] as triangles: marching tetrahedra on a lattice of about spacing h
+// (six tetrahedra about each cube's main diagonal), the crossings linearly interpolated, each triangle facing f's
+// positive side.
+template <class F>
+void level_set_triangles(F&& f, const Vec3& o, const Vec3& L, double h, std::vector<Vec3>& vertices,
+                         std::vector<std::array<int, 3>>& triangles) {
+  std::array<int, 3> n{};
+  for (int a = 0; a < 3; ++a) n[a] = std::max(1, static_cast<int>(std::ceil(L[a] / h)));
+  const auto node = [&](int i, int j, int k) {
+    return o + Vec3{L.x * i / n[0], L.y * j / n[1], L.z * k / n[2]};
+  };
+  const auto at = [&](int i, int j, int k) {
+    return (static_cast<std::size_t>(k) * (n[1] + 1) + j) * (n[0] + 1) + i;
+  };
+  std::vector<double> value(static_cast<std::size_t>(n[0] + 1) * (n[1] + 1) * (n[2] + 1));
+  for (int k = 0; k <= n[2]; ++k)
+    for (int j = 0; j <= n[1]; ++j)
+      for (int i = 0; i <= n[0]; ++i) value[at(i, j, k)] = f(node(i, j, k));
+  constexpr std::array<std::array<int, 3>, 6> orders{{{0, 1, 2}, {0, 2, 1}, {1, 0, 2}, {1, 2, 0}, {2, 0, 1}, {2, 1, 0}}};
+  const auto emit = [&](const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& up) {
+    const int base = static_cast<int>(vertices.size());
+    vertices.push_back(a);
+    const bool flip = dot(cross(b - a, c - a), up) < 0;
+    vertices.push_back(flip ? c : b);
+    vertices.push_back(flip ? b : c);
+    triangles.push_back({base, base + 1, base + 2});
+  };
+  for (int k = 0; k < n[2]; ++k)
+    for (int j = 0; j < n[1]; ++j)
+      for (int i = 0; i < n[0]; ++i)
+        for (const auto& ord : orders) {
+          std::array<std::array<int, 3>, 4> c{};
+          c[0] = {i, j, k};
+          for (int v = 1; v < 4; ++v) {
+            c[v] = c[v - 1];
+            ++c[v][ord[v - 1]];
+          }
+          std::array<Vec3, 4> x;
+          std::array<double, 4> phi;
+          Vec3 pos{}, neg{};
+          int below = 0;
+          for (int v = 0; v < 4; ++v) {
+            x[v] = node(c[v][0], c[v][1], c[v][2]);
+            phi[v] = value[at(c[v][0], c[v][1], c[v][2])];
+            if (phi[v] <= 0) {
+              ++below;
+              neg += x[v];
+            } else {
+              pos += x[v];
+            }
+          }
+          if (below == 0 || below == 4) continue;
+          const Vec3 up = pos / (4 - below) - neg / below;
+          const auto cut = [&](int a, int b) { return x[a] + (phi[a] / (phi[a] - phi[b])) * (x[b] - x[a]); };
+          std::array<int, 4> in{}, out{};
+          int ni = 0, no = 0;
+          for (int v = 0; v < 4; ++v) (phi[v] <= 0 ? in[ni++] : out[no++]) = v;
+          if (ni == 1) {
+            emit(cut(in[0], out[0]), cut(in[0], out[1]), cut(in[0], out[2]), up);
+          } else if (ni == 3) {
+            emit(cut(out[0], in[0]), cut(out[0], in[1]), cut(out[0], in[2]), up);
+          } else {
+            const Vec3 p0 = cut(in[0], out[0]), p1 = cut(in[0], out[1]), p2 = cut(in[1], out[1]),
+                       p3 = cut(in[1], out[0]);
+            emit(p0, p1, p2, up);
+            emit(p0, p2, p3, up);
+          }
+        }
+}
+
 }  // namespace
 
 WallGeometry::WallGeometry(std::vector<WallShape> shapes, const Grid& grid)
@@ -50,6 +147,10 @@ WallGeometry::WallGeometry(std::vector<WallShape> shapes, const Grid& grid)
           throw InputError(s.name + ": the surface (bounding box " + point_text(lo) + " to " + point_text(hi) +
                            ") lies outside the box " + point_text(origin_) + " to " + point_text(origin_ + length_) +
                            " (is the file in another unit? scale converts it to metres)");
+      continue;
+    }
+    if (s.kind == WallShape::Kind::Box || s.kind == WallShape::Kind::Constriction) {
+      check_block(s);
       continue;
     }
     if (!(s.radius > 0) || !std::isfinite(s.radius))
@@ -105,8 +206,101 @@ WallGeometry::WallGeometry(std::vector<WallShape> shapes, const Grid& grid)
   }
 }
 
+void WallGeometry::check_block(WallShape& s) const {
+  if (!isfinite(s.center)) throw InputError(s.name + ".center = " + point_text(s.center) + ": must be finite");
+  for (int a = 0; a < 3; ++a)
+    if (s.center[a] < origin_[a] || s.center[a] > origin_[a] + length_[a])
+      throw InputError(s.name + ".center = " + point_text(s.center) + ": must lie in the box");
+  const auto positive = [&](const Vec3& v, const std::string& key) {
+    for (int a = 0; a < 3; ++a)
+      if (!(v[a] > 0) || !std::isfinite(v[a]))
+        throw InputError(s.name + "." + key + " = " + point_text(v) + ": every edge must be positive");
+  };
+  positive(s.size, "size");
+  if (s.kind == WallShape::Kind::Box) {
+    if (s.size.x >= length_.x && s.size.y >= length_.y && s.size.z >= length_.z)
+      throw InputError(s.name + ".size = " + point_text(s.size) + ": the box spans the whole periodic box " +
+                       point_text(length_) + (s.fluid_inside ? " (no wall is left)" : " (no fluid is left)") +
+                       "; an edge must be below the box's length along at least one axis");
+    return;
+  }
+  int t = -1;
+  for (int a = 0; a < 3; ++a)
+    if (std::abs(s.axis[a]) == 1.0 && s.axis[(a + 1) % 3] == 0 && s.axis[(a + 2) % 3] == 0) t = a;
+  if (t < 0)
+    throw InputError(s.name + ".axis = " + point_text(s.axis) +
+                     ": a constriction's channel runs along a coordinate axis ([1, 0, 0], [0, 1, 0] or [0, 0, 1])");
+  s.axis = Vec3{};
+  s.axis[t] = 1.0;
+  positive(s.throat, "throat");
+  if (s.throat[t] >= length_[t])
+    throw InputError(s.name + ".throat = " + point_text(s.throat) + ": the throat's length along " + axis_name(t) +
+                     " must be below the box's " + num_text(length_[t]));
+  bool narrower = false;
+  for (int a = 0; a < 3; ++a)
+    if (a != t) {
+      if (s.throat[a] > s.size[a])
+        throw InputError(s.name + ".throat = " + point_text(s.throat) + ": wider than the channel (size = " +
+                         point_text(s.size) + ") along " + axis_name(a));
+      narrower = narrower || (s.throat[a] < s.size[a] && s.throat[a] < length_[a]);
+    }
+  if (!narrower)
+    throw InputError(s.name + ".throat = " + point_text(s.throat) +
+                     ": must be narrower than the channel (size = " + point_text(s.size) + ") across at least one axis");
+}
+
+bool WallGeometry::invariant_along(int a) const {
+  if (shapes_.empty()) return false;
+  for (const WallShape& s : shapes_) {
+    const bool tube = s.kind == WallShape::Kind::Tube && std::abs(s.axis[a]) == 1.0;
+    const bool duct = s.kind == WallShape::Kind::Box && s.size[a] >= length_[a];
+    if (!tube && !duct) return false;
+  }
+  return true;
+}
+
+double WallGeometry::block_distance(const WallShape& s, const Vec3& x, Vec3& grad) const {
+  Vec3 r = x - s.center;
+  for (int a = 0; a < 3; ++a) r[a] -= length_[a] * std::floor(r[a] / length_[a] + 0.5);
+  std::array<bool, 3> span{};
+  for (int a = 0; a < 3; ++a) span[a] = s.size[a] >= length_[a];
+  if (s.kind == WallShape::Kind::Box) {
+    const double b = box_distance(r, 0.5 * s.size, span, grad);
+    if (!s.fluid_inside) return b;
+    grad = -grad;
+    return -b;
+  }
+  const int t = s.axis.x != 0 ? 0 : s.axis.y != 0 ? 1 : 2;
+  span[t] = true;
+  Vec3 g_channel, g_throat;
+  const double channel = -box_distance(r, 0.5 * s.size, span, g_channel);
+  std::array<bool, 3> throat_span{};
+  throat_span[t] = true;
+  for (int a = 0; a < 3; ++a)
+    if (a != t) throat_span[a] = s.throat[a] >= length_[a];
+  const double throat = -box_distance(r, 0.5 * s.throat, throat_span, g_throat);
+  const double slab = std::abs(r[t]) - 0.5 * s.throat[t];
+  // The throat's frame (the slab less the throat) is solid: φ_frame = max(slab, fluid-side distance of the throat).
+  double frame;
+  Vec3 g_frame{};
+  if (slab >= throat) {
+    frame = slab;
+    g_frame[t] = r[t] >= 0 ? 1.0 : -1.0;
+  } else {
+    frame = throat;
+    g_frame = -g_throat;
+  }
+  if (channel <= frame) {
+    grad = -g_channel;
+    return channel;
+  }
+  grad = g_frame;
+  return frame;
+}
+
 double WallGeometry::shape_distance(const WallShape& s, const Vec3& x, Vec3& grad) const {
   if (s.kind == WallShape::Kind::Surface) return surface_distance(s, x, grad);
+  if (s.kind == WallShape::Kind::Box || s.kind == WallShape::Kind::Constriction) return block_distance(s, x, grad);
   Vec3 r = x - s.center;
   for (int a = 0; a < 3; ++a)
     if (periodic_[a]) r[a] -= length_[a] * std::floor(r[a] / length_[a] + 0.5);
@@ -199,6 +393,13 @@ void WallGeometry::triangulate(double h, std::vector<Vec3>& vertices, std::vecto
     if (s.kind == WallShape::Kind::Surface) {
       for (const Vec3& v : s.surface->vertices()) vertices.push_back(v);
       for (const auto& t : s.surface->triangles()) triangles.push_back({base + t[0], base + t[1], base + t[2]});
+      shape_of.resize(triangles.size(), static_cast<int>(k));
+      continue;
+    }
+    if (s.kind == WallShape::Kind::Box || s.kind == WallShape::Kind::Constriction) {
+      Vec3 g;
+      level_set_triangles([&](const Vec3& x) { return block_distance(s, x, g); }, origin_, length_, h, vertices,
+                          triangles);
       shape_of.resize(triangles.size(), static_cast<int>(k));
       continue;
     }
