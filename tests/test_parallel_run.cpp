@@ -264,7 +264,7 @@ TEST(ParallelRun, RedCellChannelWithViscosityContrastAndVolumeCorrectionEqualsTh
   if (Communicator::world().rank() != 0) return;
   // Every cell of the distributed run keeps its initial volume.
   const io::Config config = channel("rk2", kViscositySteps, sets);
-  const MembraneSet set = build_membrane_set(config, run_grid(config));
+  const MembraneSet set = build_membrane_set(config, run_grid(config), nullptr);
   ASSERT_EQ(set.meshes.size(), a.positions.size());
   double error = 0;
   for (std::size_t m = 0; m < a.positions.size(); ++m) {

@@ -206,7 +206,7 @@ int run_command(const CommandLine& options, std::ostream& out, std::ostream& err
     sim = build_simulation(config, world);
     scenario = make_scenario_run(config);
     budget_continued = start_or_restore(*sim, *scenario, options.restart);
-    copies = MeshCopies::of(config);
+    copies = MeshCopies::of(config, sim->fluid_params().walls.get());
   } catch (const InputError& e) {
     error = e.what();
   } catch (const StopRequested&) {  // while packing the cells (on every process): nothing has been written

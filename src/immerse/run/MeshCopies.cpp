@@ -14,7 +14,7 @@
 
 namespace immerse {
 
-MeshCopies MeshCopies::of(const io::Config& config) {
+MeshCopies MeshCopies::of(const io::Config& config, const WallGeometry* walls) {
   MeshCopies copies{config, {}};
   std::map<std::filesystem::path, std::string> copy_of;  // the source file -> the name of its copy
   // Copies the file of key k (unless left out or empty) as `name`, once per source file, and names the copy in k.
@@ -44,8 +44,7 @@ MeshCopies MeshCopies::of(const io::Config& config) {
     copy(k, "mesh_wall" + std::to_string(i) + (gmsh ? ".msh" : ".stl"));
   }
   // The walls as ParaView sees them: walls.xdmf, their triangulated surfaces inline.
-  if (config.count("wall") > 0) {
-    const std::shared_ptr<const WallGeometry> walls = run_fluid_params(config).walls;
+  if (walls) {
     copies.files.emplace_back("walls.xdmf", io::walls_xdmf(*walls, run_grid(config).h()));
   }
   return copies;

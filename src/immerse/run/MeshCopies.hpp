@@ -12,12 +12,15 @@
 
 namespace immerse {
 
+class WallGeometry;
+
 struct MeshCopies {
   io::Config config;
   std::vector<std::pair<std::string, std::string>> files;  ///< name in the run folder, content
 
-  /// Reads the mesh files of `config` (InputError if one cannot be read).
-  static MeshCopies of(const io::Config& config);
+  /// Reads the mesh files of `config` (InputError if one cannot be read); with `walls` (those the run holds), their
+  /// surfaces as walls.xdmf.
+  static MeshCopies of(const io::Config& config, const WallGeometry* walls);
 };
 
 }  // namespace immerse

@@ -110,9 +110,9 @@ FluidParams run_fluid_params(const io::Config& c) {
   return p;
 }
 
-ContactSettings run_contact_settings(const io::Config& c) {
+ContactSettings run_contact_settings(const io::Config& c, std::shared_ptr<const WallGeometry> walls) {
   ContactSettings s{c.get<double>("contact.range"), c.get<double>("contact.strength"), c.get<bool>("contact.walls"), {}};
-  if (s.walls && c.count("wall") > 0) s.shapes = run_fluid_params(c).walls;
+  if (s.walls) s.shapes = std::move(walls);
   return s;
 }
 

@@ -21,8 +21,8 @@ Grid run_grid(const io::Config& config);
 FluidParams run_fluid_params(const io::Config& config);
 /// fluid.fft_planning.
 FftPlanning run_fft_planning(const io::Config& config);
-/// contact.*.
-ContactSettings run_contact_settings(const io::Config& config);
+/// contact.*, the walls of [[wall]] (built once, by run_fluid_params) repelling the nodes when contact.walls.
+ContactSettings run_contact_settings(const io::Config& config, std::shared_ptr<const WallGeometry> walls);
 /// time.theta and solver.*.
 SolverSettings run_solver_settings(const io::Config& config);
 /// The fluid at t = 0 on the whole grid (fluid.initial: at rest, Poiseuille or Couette flow), wall velocities set.

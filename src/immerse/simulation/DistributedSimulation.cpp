@@ -50,13 +50,14 @@ DistributedSimulation::DistributedSimulation(const io::Config& config, Communica
       threads_(ThreadGovernor::from_environment()),
       fluid_(grid_, run_fluid_params(config), comm, run_fft_planning(config)),
       coupler_(fluid_.decomposition(), delta_kernel(config.get<std::string>("coupling.kernel"))),
-      membranes_(build_membrane_set(config, grid_, agreed(comm, stop_requested))),
+      membranes_(build_membrane_set(config, grid_, fluid_.params().walls, agreed(comm, stop_requested))),
       stepper_(config.get<double>("time.dt"), config.get<double>("time.dt_min")) {
   std::vector<const ElasticMembrane*> ms;
   for (const auto& m : membranes_.membranes) ms.push_back(m.get());
   op_ = std::make_unique<DistributedOperator>(
       fluid_, coupler_, std::move(ms), membranes_.initial, membranes_.references,
-      fluid_.scatter(run_initial_fluid_state(config_, grid_, fluid_.params())), run_contact_settings(config_),
+      fluid_.scatter(run_initial_fluid_state(config_, grid_, fluid_.params())),
+      run_contact_settings(config_, fluid_.params().walls),
       membranes_.viscosity_ratio);
   op_->set_thread_governor(threads_);
   integrator_ = make_integrator(config_.get<std::string>("time.scheme"), run_solver_settings(config_),
@@ -278,7 +279,7 @@ void DistributedSimulation::restore(const io::Checkpoint& ck) {
   std::vector<const ElasticMembrane*> ms;
   for (const auto& m : membranes_.membranes) ms.push_back(m.get());
   op_ = std::make_unique<DistributedOperator>(fluid_, coupler_, std::move(ms), X, membranes_.references,
-                                              fluid_.scatter(f), run_contact_settings(config_),
+                                              fluid_.scatter(f), run_contact_settings(config_, fluid_.params().walls),
                                               membranes_.viscosity_ratio);
   op_->set_thread_governor(threads_);
   integrator_->prepare(op_->size());

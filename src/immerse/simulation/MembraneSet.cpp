@@ -99,8 +99,9 @@ std::string unit_hint(const io::Config& config, std::size_t m) {
 // The construction steps, each adding to or checking the membranes built so far.
 class Builder {
  public:
-  Builder(const io::Config& config, const Grid& grid, const std::function<bool()>& stop_requested)
-      : config_(config), grid_(grid), stop_requested_(stop_requested) {}
+  Builder(const io::Config& config, const Grid& grid, std::shared_ptr<const WallGeometry> walls,
+          const std::function<bool()>& stop_requested)
+      : config_(config), grid_(grid), walls_(std::move(walls)), stop_requested_(stop_requested) {}
   MembraneSet build() {
     build_membranes();
     pack_membranes();
@@ -118,6 +119,7 @@ class Builder {
 
   const io::Config& config_;
   const Grid& grid_;
+  std::shared_ptr<const WallGeometry> walls_;  // null without [[wall]]
   const std::function<bool()>& stop_requested_;
   std::vector<Mesh> meshes_;
   std::vector<std::vector<Vec3>> references_, initial_;
@@ -234,7 +236,7 @@ void Builder::pack_membranes() {
     for (const auto& [a, b] : {std::pair{0, 3}, {3, 1}, {1, 4}, {4, 2}, {2, 5}, {5, 0}})
       spacing = std::max(spacing, norm(shape[e[a]] - shape[e[b]]));
   PackingRequest request;
-  if (config_.count("wall") > 0) request.walls = run_fluid_params(config_).walls;
+  request.walls = walls_;
   double box = 1;  // the fluid's volume
   for (int a = 0; a < 3; ++a) box *= grid_.length(a);
   if (request.walls) box = request.walls->fluid_volume(grid_);
@@ -301,8 +303,8 @@ void Builder::check_geometry() const {
       throw InputError(s.str());
     }
   }
-  if (config_.count("wall") > 0) {
-    const std::shared_ptr<const WallGeometry> walls = run_fluid_params(config_).walls;
+  if (walls_) {
+    const std::shared_ptr<const WallGeometry>& walls = walls_;
     for (std::size_t m = 0; m < initial_.size(); ++m) {
       double nearest = std::numeric_limits<double>::infinity();
       for (const Vec3& x : initial_[m]) nearest = std::min(nearest, walls->distance(x));
@@ -346,9 +348,9 @@ void Builder::check_geometry() const {
 
 }  // namespace
 
-MembraneSet build_membrane_set(const io::Config& config, const Grid& grid,
+MembraneSet build_membrane_set(const io::Config& config, const Grid& grid, std::shared_ptr<const WallGeometry> walls,
                                const std::function<bool()>& stop_requested) {
-  return Builder(config, grid, stop_requested).build();
+  return Builder(config, grid, std::move(walls), stop_requested).build();
 }
 
 }  // namespace immerse

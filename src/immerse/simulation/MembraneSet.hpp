@@ -24,6 +24,8 @@
 
 namespace immerse {
 
+class WallGeometry;
+
 /// "membrane[m]": membrane m as keys and messages name it.
 std::string membrane_name(std::size_t m);
 
@@ -38,9 +40,10 @@ struct MembraneSet {
   std::string packing_summary;
 };
 
-/// Builds, packs and checks the membranes of `config` (already through apply_scenario) in the box of `grid`.
-/// `stop_requested`, when given, is asked while [packing] places the cells: true throws StopRequested.
-MembraneSet build_membrane_set(const io::Config& config, const Grid& grid,
+/// Builds, packs and checks the membranes of `config` (already through apply_scenario) in the box of `grid`, in the
+/// fluid of `walls` (the [[wall]] shapes the fluid solver holds; null without). `stop_requested`, when given, is asked
+/// while [packing] places the cells: true throws StopRequested.
+MembraneSet build_membrane_set(const io::Config& config, const Grid& grid, std::shared_ptr<const WallGeometry> walls,
                                const std::function<bool()>& stop_requested = {});
 
 }  // namespace immerse

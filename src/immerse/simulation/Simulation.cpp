@@ -27,7 +27,7 @@ Simulation::Simulation(const io::Config& config, const std::function<bool()>& st
       fluid_(grid_, run_fluid_params(config), run_fft_planning(config)),
       coupler_(grid_, delta_kernel(config.get<std::string>("coupling.kernel"))),
       stepper_(config.get<double>("time.dt"), config.get<double>("time.dt_min")) {
-  MembraneSet set = build_membrane_set(config_, grid_, stop_requested);
+  MembraneSet set = build_membrane_set(config_, grid_, fluid_.params().walls, stop_requested);
   meshes_ = std::move(set.meshes);
   references_ = std::move(set.references);
   initial_ = std::move(set.initial);
@@ -39,7 +39,8 @@ Simulation::Simulation(const io::Config& config, const std::function<bool()>& st
   for (auto& m : membranes_) ms.push_back(m.get());
   op_ = std::make_unique<ImmersedBoundaryOperator>(fluid_, coupler_, ms, initial_,
                                                    run_initial_fluid_state(config_, grid_, fluid_.params()),
-                                                   run_contact_settings(config), viscosity_ratio_);
+                                                   run_contact_settings(config, fluid_.params().walls),
+                                                   viscosity_ratio_);
   op_->set_thread_governor(threads_);
   integrator_ = make_integrator(config.get<std::string>("time.scheme"), run_solver_settings(config));
   if (integrator_->name() == "bfgs" && op_->size() > DenseBfgs::max_unknowns)
@@ -223,7 +224,8 @@ void Simulation::restore(const io::Checkpoint& ck) {
   }
   std::vector<const ElasticMembrane*> ms;
   for (auto& m : membranes_) ms.push_back(m.get());
-  op_ = std::make_unique<ImmersedBoundaryOperator>(fluid_, coupler_, ms, X, std::move(f), run_contact_settings(config_),
+  op_ = std::make_unique<ImmersedBoundaryOperator>(fluid_, coupler_, ms, X, std::move(f),
+                                                   run_contact_settings(config_, fluid_.params().walls),
                                                    viscosity_ratio_);
   integrator_->set_history(prev_X, prev_dt, guess_errors);
   stepper_.set_state(dt, static_cast<int>(successes));
