@@ -390,9 +390,9 @@ TEST(WallSurface, ConfigurationBuildsTheSurfaceWall) {
       run_fluid_params(parse("shape = \"surface\"\nfile = \"cube.stl\"\nscale = 1e-6\ninside = \"fluid\"\n"));
   EXPECT_NEAR(q.walls->distance({1e-6, 1e-6, 1e-6}), 0.25e-6, 1e-21);
   EXPECT_EQ(error_of([&] { parse("shape = \"surface\"\nfile = \"cube.stl\"\nradius = 1e-6\n"); }),
-            "wall[0].radius: does not apply to shape = \"surface\" (the file gives the shape; use scale)");
+            "wall[0].radius: does not apply to shape = \"surface\" (its keys: file, inside, scale)");
   EXPECT_EQ(error_of([&] { parse("shape = \"tube\"\nradius = 0.5e-6\nfile = \"a.stl\"\n"); }),
-            "wall[0].file: does not apply unless shape = \"surface\"");
+            "wall[0].file: does not apply to shape = \"tube\" (its keys: axis, center, radius)");
   EXPECT_EQ(error_of([&] { parse("shape = \"surface\"\n"); }),
             "wall[0].file: must be given (an STL or Gmsh file name) when shape = \"surface\"");
   // In micrometres without scale: outside the box.
