@@ -188,7 +188,9 @@ std::vector<Check> fluid_divergence(bool quick) {
       worst = std::fmax(worst, dmax * g.h() / max_abs_velocity(g, b.u));
       std::swap(a, b);
     }
-    checks.push_back({"max|D u| h / max|u| after projection, " + bc_name(bc), worst, "<=", 1e-12});
+    std::string name = "max|D u| h / max|u| after projection, ";  // (+=: GCC 12 warns falsely on literal + string)
+    name += bc_name(bc);
+    checks.push_back({name, worst, "<=", 1e-12});
   }
   return checks;
 }
